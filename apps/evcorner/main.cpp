@@ -1,0 +1,38 @@
+// evcorner: corner detection on event-camera streams.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+    CLI::App app{
+        "evcorner: turn an event-camera stream into a stream of corner events.\n"
+        "Runs eFAST (Mueggler, Bartolozzi, Scaramuzza, BMVC 2017) event by event on the\n"
+        "Surface of Active Events. Use 'evcorner COMMAND --help' for a command's options."};
+    app.name("evcorner");
+    app.set_version_flag("--version", "evcorner " EVCORNER_VERSION);
+    app.require_subcommand(1);
+    app.footer(
+        "Example:\n"
+        "  evcorner detect events.txt -o corners.txt     # Event-Camera-Dataset text in and out\n"
+        "Exit status: 0 on success, 1 on bad input or a failed write, 2 on a usage error.");
+    evcorner::cli::add_detect_command(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "evcorner: error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

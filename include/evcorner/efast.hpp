@@ -1,0 +1,44 @@
+#pragma once
+// eFAST: the event-based FAST corner detector of
+//   E. Mueggler, C. Bartolozzi, D. Scaramuzza, "Fast Event-based Corner Detection",
+//   BMVC 2017.
+// Per event: write its timestamp into the SAE of its polarity; away from the border,
+// it is a corner iff on that SAE the radius-3 circle has a contiguous arc of 3..6
+// pixels all strictly newer than the rest of the circle, and the radius-4 circle one
+// of 4..8 pixels (docs/algorithms.md fixes every detail).
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "evcorner/circle.hpp"
+#include "evcorner/detector.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/sae.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner {
+
+class EFast {
+public:
+    static constexpr int kArc3Min = 3, kArc3Max = 6;
+    static constexpr int kArc4Min = 4, kArc4Max = 8;
+
+    explicit EFast(SensorSize size);
+
+    /// Updates the SAE with `e` and answers whether `e` is a corner event.
+    /// `e` must lie on the sensor (readers validate).
+    bool process(const Event& e) noexcept;
+
+    [[nodiscard]] const Sae& sae() const noexcept { return sae_; }
+    [[nodiscard]] SensorSize size() const noexcept { return sae_.size(); }
+    [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
+
+private:
+    Sae sae_;
+    std::array<std::ptrdiff_t, kCircle3.size()> off3_{};  // circle offsets in one SAE plane
+    std::array<std::ptrdiff_t, kCircle4.size()> off4_{};
+};
+static_assert(Detector<EFast>);
+
+}  // namespace evcorner

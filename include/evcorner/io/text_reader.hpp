@@ -1,0 +1,77 @@
+#pragma once
+// Streaming reader for the Event-Camera-Dataset text format (Mueggler et al., IJRR 2017):
+// one event per line, "t x y p", t in seconds (up to 9 decimals read exactly; more are
+// allowed), x and y pixel coordinates, p = 1 (ON) or 0 (OFF), separated by spaces or tabs.
+// Blank lines and lines starting with '#' are skipped; CRLF line ends are accepted.
+//
+// Time is rounded to the nearest microsecond (halves away from zero) with integer
+// arithmetic. Memory is constant whatever the file size. Every error names the file,
+// the 1-based line and the offending text.
+
+#include <cstdint>
+#include <exception>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "evcorner/event.hpp"
+#include "evcorner/io/input_file.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner::io {
+
+struct TextReaderOptions {
+    /// When set, an event outside the sensor is an error (or skipped, below).
+    std::optional<SensorSize> sensor;
+    /// Skip events outside the sensor instead of failing; they are counted.
+    bool skip_invalid = false;
+};
+
+class TextReader {
+public:
+    /// Opens `path` ("-" = standard input). Throws InputError.
+    explicit TextReader(std::string path, TextReaderOptions options = {});
+
+    /// Fills `out` with the next events; returns how many (0 at the end).
+    /// Throws InputError on bad input. Events parsed before a bad line are
+    /// returned first; the error is thrown by the following call.
+    std::size_t read(std::span<Event> out);
+
+    /// Events skipped as outside the sensor during the last read(), as runs: `count`
+    /// consecutive skipped events stood just before out[before] (before == n: after all).
+    struct SkipRun {
+        std::size_t before;
+        std::uint64_t count;
+    };
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept {
+        return skipped_in_batch_;
+    }
+    [[nodiscard]] std::uint64_t skipped() const noexcept { return skipped_; }
+    [[nodiscard]] std::uint64_t events() const noexcept { return events_; }
+    /// Lines consumed so far.
+    [[nodiscard]] std::uint64_t line() const noexcept { return line_; }
+    [[nodiscard]] const InputFile& file() const noexcept { return file_; }
+
+private:
+    bool next_line(const char*& begin, const char*& end);
+    [[noreturn]] void fail(const char* begin, const char* end, const std::string& reason) const;
+
+    InputFile file_;
+    TextReaderOptions options_;
+    std::vector<char> buf_;
+    std::size_t pos_ = 0;    // start of unparsed data in buf_
+    std::size_t fill_ = 0;   // bytes valid in buf_
+    bool eof_ = false;
+    std::uint64_t line_ = 0;
+    std::uint64_t events_ = 0;
+    std::uint64_t skipped_ = 0;
+    std::int64_t last_t_ = INT64_MIN;
+    std::vector<SkipRun> skipped_in_batch_;
+    std::exception_ptr pending_;
+};
+
+/// Reads a whole text file into memory (tests, small tools).
+std::vector<Event> read_text_file(const std::string& path, TextReaderOptions options = {});
+
+}  // namespace evcorner::io

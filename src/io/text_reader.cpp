@@ -1,0 +1,197 @@
+#include "evcorner/io/text_reader.hpp"
+
+#include <cstring>
+#include <utility>
+#include <fmt/format.h>
+
+#include "evcorner/error.hpp"
+
+namespace evcorner::io {
+
+namespace {
+
+constexpr std::size_t kBufferSize = 1 << 20;
+// |t| below this many seconds keeps t in microseconds far from int64 overflow.
+constexpr std::int64_t kMaxSeconds = 9'000'000'000'000;
+
+inline bool is_space(char c) { return c == ' ' || c == '\t'; }
+inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
+
+// The offending line, shortened and with unprintable bytes escaped.
+std::string quote(const char* b, const char* e) {
+    std::string s;
+    const bool cut = e - b > 80;
+    if (cut) e = b + 80;
+    for (const char* p = b; p < e; ++p) {
+        const auto c = static_cast<unsigned char>(*p);
+        if (c >= 0x20 && c < 0x7f)
+            s += static_cast<char>(c);
+        else
+            s += fmt::format("\\x{:02x}", c);
+    }
+    return "'" + s + (cut ? "...'" : "'");
+}
+
+struct Parsed {
+    Event e{};
+    const char* error = nullptr;  // reason, or nullptr when the line parsed
+};
+
+// Parses "t x y p" from [p, end). `end` excludes the line break.
+Parsed parse_line(const char* p, const char* end) {
+    Parsed r;
+    while (p < end && is_space(*p)) ++p;
+
+    bool negative = false;
+    if (p < end && (*p == '-' || *p == '+')) negative = *p++ == '-';
+    std::int64_t sec = 0;
+    int int_digits = 0;
+    while (p < end && is_digit(*p)) {
+        sec = sec * 10 + (*p++ - '0');
+        if (++int_digits > 13) return {r.e, "timestamp too large"};
+    }
+    std::int64_t frac_ns = 0;
+    int frac_digits = 0;
+    if (p < end && *p == '.') {
+        ++p;
+        while (p < end && is_digit(*p)) {
+            if (frac_digits < 9) frac_ns = frac_ns * 10 + (*p - '0');
+            ++frac_digits;
+            ++p;
+        }
+    }
+    if (int_digits == 0 && frac_digits == 0) return {r.e, "expected a timestamp in seconds"};
+    if (sec >= kMaxSeconds) return {r.e, "timestamp too large"};
+    for (int d = frac_digits; d < 9; ++d) frac_ns *= 10;
+    // Nearest microsecond, halves away from zero; digits past the 9th cannot change it.
+    std::int64_t us = sec * 1'000'000 + frac_ns / 1000 + (frac_ns % 1000 >= 500 ? 1 : 0);
+    r.e.t = negative ? -us : us;
+
+    std::uint32_t coord[2];
+    for (int i = 0; i < 2; ++i) {
+        if (p == end || !is_space(*p))
+            return {r.e, i == 0 ? "expected a space and x after the timestamp"
+                                : "expected a space and y after x"};
+        while (p < end && is_space(*p)) ++p;
+        if (p == end || !is_digit(*p))
+            return {r.e, i == 0 ? "expected x, a non-negative integer"
+                                : "expected y, a non-negative integer"};
+        std::uint32_t v = 0;
+        int digits = 0;
+        while (p < end && is_digit(*p)) {
+            v = v * 10 + static_cast<std::uint32_t>(*p++ - '0');
+            if (++digits > 6) break;
+        }
+        if (v >= 65536 || digits > 5)
+            return {r.e, i == 0 ? "x does not fit 16 bits" : "y does not fit 16 bits"};
+        coord[i] = v;
+    }
+    r.e.x = static_cast<std::uint16_t>(coord[0]);
+    r.e.y = static_cast<std::uint16_t>(coord[1]);
+
+    if (p == end || !is_space(*p)) return {r.e, "expected a space and the polarity after y"};
+    while (p < end && is_space(*p)) ++p;
+    if (p == end || (*p != '0' && *p != '1') || (p + 1 < end && !is_space(p[1])))
+        return {r.e, "polarity must be 0 or 1"};
+    r.e.p = static_cast<std::uint8_t>(*p++ - '0');
+    while (p < end && is_space(*p)) ++p;
+    if (p != end) return {r.e, "unexpected text after the polarity"};
+    return r;
+}
+
+}  // namespace
+
+TextReader::TextReader(std::string path, TextReaderOptions options)
+    : file_(std::move(path)), options_(options), buf_(kBufferSize) {}
+
+void TextReader::fail(const char* begin, const char* end, const std::string& reason) const {
+    throw InputError(file_.name(), InputError::Unit::line, line_,
+                     reason + ": " + quote(begin, end));
+}
+
+// Finds the next line in the buffer, refilling it as needed. [begin, end) excludes
+// the line break. Returns false at end of input.
+bool TextReader::next_line(const char*& begin, const char*& end) {
+    for (;;) {
+        const char* data = buf_.data();
+        const void* nl = std::memchr(data + pos_, '\n', fill_ - pos_);
+        if (nl != nullptr) {
+            begin = data + pos_;
+            end = static_cast<const char*>(nl);
+            pos_ = static_cast<std::size_t>(end - data) + 1;
+            ++line_;
+            return true;
+        }
+        if (eof_) {
+            if (pos_ == fill_) return false;
+            begin = data + pos_;  // last line without a line break
+            end = data + fill_;
+            pos_ = fill_;
+            ++line_;
+            return true;
+        }
+        if (pos_ == 0 && fill_ == buf_.size()) {
+            ++line_;
+            fail(data, data + 80, fmt::format("line longer than {} bytes", buf_.size()));
+        }
+        std::memmove(buf_.data(), buf_.data() + pos_, fill_ - pos_);
+        fill_ -= pos_;
+        pos_ = 0;
+        const std::size_t n = file_.read(std::span<char>(buf_.data() + fill_, buf_.size() - fill_));
+        if (n == 0) eof_ = true;
+        fill_ += n;
+    }
+}
+
+std::size_t TextReader::read(std::span<Event> out) {
+    skipped_in_batch_.clear();
+    if (pending_) std::rethrow_exception(std::exchange(pending_, nullptr));
+    std::size_t n = 0;
+    try {
+        const char* b;
+        const char* e;
+        while (n < out.size() && next_line(b, e)) {
+            if (e > b && e[-1] == '\r') --e;
+            const char* q = b;
+            while (q < e && is_space(*q)) ++q;
+            if (q == e || *q == '#') continue;
+            const Parsed r = parse_line(b, e);
+            if (r.error != nullptr) fail(b, e, r.error);
+            if (r.e.t < last_t_)
+                fail(b, e,
+                     fmt::format("timestamp goes backwards ({} us before the previous event)",
+                                 last_t_ - r.e.t));
+            if (options_.sensor && !options_.sensor->contains(r.e)) {
+                if (!options_.skip_invalid)
+                    fail(b, e,
+                         fmt::format("event at x={} y={} lies outside the {}x{} sensor "
+                                     "(set --size, or --skip-invalid to skip such events)",
+                                     r.e.x, r.e.y, options_.sensor->width,
+                                     options_.sensor->height));
+                ++skipped_;
+                if (!skipped_in_batch_.empty() && skipped_in_batch_.back().before == n)
+                    ++skipped_in_batch_.back().count;  // one run per gap: memory stays bounded
+                else
+                    skipped_in_batch_.push_back({n, 1});
+                continue;
+            }
+            last_t_ = r.e.t;
+            out[n++] = r.e;
+        }
+    } catch (const InputError&) {
+        if (n == 0) throw;
+        pending_ = std::current_exception();
+    }
+    events_ += n;
+    return n;
+}
+
+std::vector<Event> read_text_file(const std::string& path, TextReaderOptions options) {
+    TextReader reader(path, options);
+    std::vector<Event> all;
+    std::vector<Event> chunk(1 << 16);
+    while (const std::size_t n = reader.read(chunk)) all.insert(all.end(), chunk.begin(), chunk.begin() + n);
+    return all;
+}
+
+}  // namespace evcorner::io
