@@ -49,7 +49,7 @@ struct Totals {
 };
 
 void write_mask(io::OutputFile& mask, const std::vector<std::uint8_t>& flags, std::size_t n,
-                std::span<const io::TextReader::SkipRun> skips) {
+                std::span<const io::SkipRun> skips) {
     static constexpr char kLine[2][2] = {{'0', '\n'}, {'1', '\n'}};
     auto put_zeros = [&](std::uint64_t count) {
         for (std::uint64_t k = 0; k < count; ++k) mask.write({kLine[0], 2});
@@ -115,7 +115,7 @@ void run_detect(const DetectOptions& o) {
     std::unique_ptr<io::OutputFile> mask_out;
     if (!o.mask.empty()) mask_out = std::make_unique<io::OutputFile>(o.mask);
 
-    Progress progress(!o.quiet && !o.no_progress, reader.file().size());
+    Progress progress(!o.quiet && !o.no_progress, reader.bytes_total());
     std::vector<Event> events(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
     Totals totals;
@@ -142,7 +142,7 @@ void run_detect(const DetectOptions& o) {
                     for (std::size_t i = 0; i < n; ++i)
                         if (flags[i]) corners_out.write(events[i]);
                     if (mask_out) write_mask(*mask_out, flags, n, skips);
-                    progress.update(reader.file().consumed(), totals.events);
+                    progress.update(reader.bytes_consumed(), totals.events);
                 }
             },
             detector);

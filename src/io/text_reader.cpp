@@ -101,7 +101,7 @@ Parsed parse_line(const char* p, const char* end) {
 
 }  // namespace
 
-TextReader::TextReader(std::string path, TextReaderOptions options)
+TextReader::TextReader(std::string path, ReaderOptions options)
     : file_(std::move(path)), options_(options), buf_(kBufferSize) {}
 
 void TextReader::fail(const char* begin, const char* end, const std::string& reason) const {
@@ -186,7 +186,7 @@ std::size_t TextReader::read(std::span<Event> out) {
     return n;
 }
 
-std::vector<Event> read_text_file(const std::string& path, TextReaderOptions options) {
+std::vector<Event> read_text_file(const std::string& path, ReaderOptions options) {
     TextReader reader(path, options);
     std::vector<Event> all;
     std::vector<Event> chunk(1 << 16);

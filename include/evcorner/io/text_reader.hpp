@@ -16,49 +16,42 @@
 #include <vector>
 
 #include "evcorner/event.hpp"
+#include "evcorner/io/event_reader.hpp"
 #include "evcorner/io/input_file.hpp"
 #include "evcorner/sensor.hpp"
 
 namespace evcorner::io {
 
-struct TextReaderOptions {
-    /// When set, an event outside the sensor is an error (or skipped, below).
-    std::optional<SensorSize> sensor;
-    /// Skip events outside the sensor instead of failing; they are counted.
-    bool skip_invalid = false;
-};
-
-class TextReader {
+/// When options.sensor is set, an event outside it is an error (or skipped).
+class TextReader final : public EventReader {
 public:
     /// Opens `path` ("-" = standard input). Throws InputError.
-    explicit TextReader(std::string path, TextReaderOptions options = {});
+    explicit TextReader(std::string path, ReaderOptions options = {});
 
     /// Fills `out` with the next events; returns how many (0 at the end).
     /// Throws InputError on bad input. Events parsed before a bad line are
     /// returned first; the error is thrown by the following call.
-    std::size_t read(std::span<Event> out);
+    std::size_t read(std::span<Event> out) override;
 
-    /// Events skipped as outside the sensor during the last read(), as runs: `count`
-    /// consecutive skipped events stood just before out[before] (before == n: after all).
-    struct SkipRun {
-        std::size_t before;
-        std::uint64_t count;
-    };
-    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept {
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override {
         return skipped_in_batch_;
     }
-    [[nodiscard]] std::uint64_t skipped() const noexcept { return skipped_; }
+    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skipped_; }
+    [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return options_.sensor; }
+    [[nodiscard]] std::string_view format() const noexcept override { return "ecd-text"; }
+    [[nodiscard]] const std::string& name() const noexcept override { return file_.name(); }
+    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return file_.consumed(); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return file_.size(); }
     [[nodiscard]] std::uint64_t events() const noexcept { return events_; }
     /// Lines consumed so far.
     [[nodiscard]] std::uint64_t line() const noexcept { return line_; }
-    [[nodiscard]] const InputFile& file() const noexcept { return file_; }
 
 private:
     bool next_line(const char*& begin, const char*& end);
     [[noreturn]] void fail(const char* begin, const char* end, const std::string& reason) const;
 
     InputFile file_;
-    TextReaderOptions options_;
+    ReaderOptions options_;
     std::vector<char> buf_;
     std::size_t pos_ = 0;    // start of unparsed data in buf_
     std::size_t fill_ = 0;   // bytes valid in buf_
@@ -72,6 +65,6 @@ private:
 };
 
 /// Reads a whole text file into memory (tests, small tools).
-std::vector<Event> read_text_file(const std::string& path, TextReaderOptions options = {});
+std::vector<Event> read_text_file(const std::string& path, ReaderOptions options = {});
 
 }  // namespace evcorner::io

@@ -1,0 +1,55 @@
+#pragma once
+// What every event-file reader offers: events in file order, in batches, with
+// constant memory. Formats differ; this contract does not.
+//
+// read(out) fills `out` and returns how many events it wrote; 0 means the end, once
+// skipped_in_batch() is empty too. Bad input throws InputError naming the file and the
+// position (line, or byte offset). Events decoded before the damage are returned first,
+// the error is thrown by the next call, so callers keep everything that was valid.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "evcorner/event.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner::io {
+
+struct ReaderOptions {
+    /// Sensor size to validate events against; overrides the file's own metadata.
+    std::optional<SensorSize> sensor;
+    /// Skip events outside the sensor instead of failing; they are counted.
+    bool skip_invalid = false;
+};
+
+/// `count` consecutive events skipped as outside the sensor, which stood just before
+/// out[before] of the last read() (before == n: after the last one returned).
+struct SkipRun {
+    std::size_t before;
+    std::uint64_t count;
+};
+
+class EventReader {
+public:
+    virtual ~EventReader() = default;
+
+    virtual std::size_t read(std::span<Event> out) = 0;
+    [[nodiscard]] virtual std::span<const SkipRun> skipped_in_batch() const noexcept = 0;
+    /// Events skipped so far.
+    [[nodiscard]] virtual std::uint64_t skipped() const noexcept = 0;
+    /// The sensor events are validated against (options, else file metadata), if known.
+    [[nodiscard]] virtual std::optional<SensorSize> sensor() const noexcept = 0;
+    /// A short name of the format, e.g. "ecd-text", "aedat2".
+    [[nodiscard]] virtual std::string_view format() const noexcept = 0;
+    /// The name to show in messages.
+    [[nodiscard]] virtual const std::string& name() const noexcept = 0;
+    /// Bytes of the file consumed so far, and its size when known (progress bars).
+    [[nodiscard]] virtual std::uint64_t bytes_consumed() const noexcept = 0;
+    [[nodiscard]] virtual std::optional<std::uint64_t> bytes_total() const noexcept = 0;
+};
+
+}  // namespace evcorner::io
