@@ -17,7 +17,7 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/error.hpp"
 #include "evcorner/io/output_file.hpp"
-#include "evcorner/io/text_reader.hpp"
+#include "evcorner/io/open.hpp"
 #include "evcorner/io/text_writer.hpp"
 #include "progress.hpp"
 
@@ -106,11 +106,13 @@ void write_summary_json(const DetectOptions& o, SensorSize size, const Totals& t
 
 void run_detect(const DetectOptions& o) {
     const auto wall_start = Clock::now();
-    SensorSize size = kDavis240;
-    if (!o.size.empty()) size = *parse_sensor_size(o.size);  // validated by CLI11
+    io::ReaderOptions ropts{.skip_invalid = o.skip_invalid};
+    if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);  // validated by CLI11
+    const std::unique_ptr<io::EventReader> source = io::open_event_reader(o.input, ropts);
+    io::EventReader& reader = *source;
+    const SensorSize size = reader.sensor().value_or(kDavis240);
 
     AnyDetector detector = make_detector(o.detector, size);
-    io::TextReader reader(o.input, {.sensor = size, .skip_invalid = o.skip_invalid});
     io::TextWriter corners_out(o.output);
     std::unique_ptr<io::OutputFile> mask_out;
     if (!o.mask.empty()) mask_out = std::make_unique<io::OutputFile>(o.mask);
