@@ -106,7 +106,8 @@ void write_summary_json(const DetectOptions& o, SensorSize size, const Totals& t
 
 void run_detect(const DetectOptions& o) {
     const auto wall_start = Clock::now();
-    io::ReaderOptions ropts{.skip_invalid = o.skip_invalid};
+    io::ReaderOptions ropts;
+    ropts.skip_invalid = o.skip_invalid;
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);  // validated by CLI11
     const std::unique_ptr<io::EventReader> source = io::open_event_reader(o.input, ropts);
     io::EventReader& reader = *source;
