@@ -1,0 +1,172 @@
+// The evcorner tool as a user runs it: outputs, mask, summary, exit codes and messages.
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "evcorner/io/text_reader.hpp"
+#include "test_util.hpp"
+
+namespace evcorner {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int status;
+    std::string out;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::size_t count_lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+class Cli : public ::testing::Test {
+protected:
+    fs::path dir_;
+    fs::path sample_ = test::bundled_data() / "ecd/shapes_translation/events.txt";
+    fs::path golden_ = test::bundled_data() / "ecd/shapes_translation/efast.golden.idx";
+
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               (std::string("evcorner-cli-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    // Runs "evcorner ARGS" through the shell from dir_, capturing both streams.
+    Result run(const std::string& args, const std::string& stdin_from = "/dev/null") {
+        const std::string cmd = "cd '" + dir_.string() + "' && '" EVCORNER_CLI "' " + args + " <" + stdin_from +
+                                " >out.stdout 2>out.stderr";
+        const int raw = std::system(cmd.c_str());
+        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir_ / "out.stdout"), slurp(dir_ / "out.stderr")};
+    }
+    std::string write(const std::string& name, const std::string& content) {
+        std::ofstream(dir_ / name, std::ios::binary) << content;
+        return (dir_ / name).string();
+    }
+};
+
+TEST_F(Cli, DetectWritesCornersMaskAndSummary) {
+    const Result r = run("detect '" + sample_.string() + "' -o corners.txt --mask mask.txt --summary-json s.json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto golden = test::read_index_file(golden_);
+    EXPECT_EQ(count_lines(slurp(dir_ / "corners.txt")), golden.size());
+
+    // The mask marks exactly the golden positions.
+    std::ifstream mask(dir_ / "mask.txt");
+    std::vector<std::uint64_t> marked;
+    std::string line;
+    std::uint64_t i = 0;
+    for (; std::getline(mask, line); ++i) {
+        ASSERT_TRUE(line == "0" || line == "1") << "line " << i + 1 << ": " << line;
+        if (line == "1") marked.push_back(i);
+    }
+    EXPECT_EQ(i, 30000u);
+    EXPECT_EQ(marked, golden);
+
+    const std::string json = slurp(dir_ / "s.json");
+    EXPECT_NE(json.find("\"events\": 30000"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"corners\": " + std::to_string(golden.size())), std::string::npos) << json;
+    EXPECT_NE(json.find("\"reduction_rate\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"ns_per_event\""), std::string::npos) << json;
+
+    EXPECT_NE(r.err.find("corners      " + std::to_string(golden.size())), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("reduction"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("ns/event"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("wall time"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, CornerLinesAreTheCornerEventsOfTheInput) {
+    const Result r = run("detect '" + sample_.string() + "' -q -o corners.txt");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+    const auto input = io::read_text_file(sample_.string());
+    std::vector<Event> expected;
+    for (const auto pos : test::read_index_file(golden_)) expected.push_back(input.at(pos));
+    EXPECT_EQ(io::read_text_file((dir_ / "corners.txt").string()), expected);
+    // Whole lines in the dataset's own style: 9 decimals.
+    const std::string text = slurp(dir_ / "corners.txt");
+    ASSERT_FALSE(text.empty());
+    EXPECT_EQ(text.back(), '\n');
+    EXPECT_EQ(text.substr(0, text.find('\n')).find('.'), 2u);
+    EXPECT_EQ(text.find(' ') - text.find('.'), 10u);
+}
+
+TEST_F(Cli, ReadsStandardInput) {
+    const Result from_file = run("detect '" + sample_.string() + "' -q");
+    const Result from_stdin = run("detect - -q", sample_.string());
+    ASSERT_EQ(from_stdin.status, 0) << from_stdin.err;
+    EXPECT_EQ(from_stdin.out, from_file.out);
+}
+
+TEST_F(Cli, MalformedLineStopsWithFileLineAndKeepsWholeLines) {
+    std::string content = slurp(sample_);
+    content += "52.1 12 oops 1\n52.2 1 1 1\n";
+    const std::string in = write("bad.txt", content);
+    const Result good = run("detect '" + sample_.string() + "' -q");
+    const Result r = run("detect bad.txt -o corners.txt --mask mask.txt");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("bad.txt:30001:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("'52.1 12 oops 1'"), std::string::npos) << r.err;
+    // Everything before the bad line was processed and written whole.
+    EXPECT_EQ(slurp(dir_ / "corners.txt"), good.out);
+    EXPECT_EQ(count_lines(slurp(dir_ / "mask.txt")), 30000u);
+}
+
+TEST_F(Cli, OutsideTheSensor) {
+    write("big.txt", "0.1 5 5 1\n0.2 300 10 0\n0.3 6 6 1\n");
+    Result r = run("detect big.txt");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("big.txt:2:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("x=300 y=10"), std::string::npos) << r.err;
+
+    r = run("detect big.txt --skip-invalid --mask m.txt --summary-json s.json");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("skipped      1"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(dir_ / "m.txt"), "0\n0\n0\n");
+    EXPECT_NE(slurp(dir_ / "s.json").find("\"skipped\": 1"), std::string::npos);
+
+    r = run("detect big.txt --size 346x260 -q");
+    EXPECT_EQ(r.status, 0) << r.err;
+}
+
+TEST_F(Cli, MissingFileAndUsageErrors) {
+    Result r = run("detect no-such-file.txt");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("no-such-file.txt: cannot open"), std::string::npos) << r.err;
+
+    r = run("detect '" + sample_.string() + "' --size 12by4");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("WxH"), std::string::npos) << r.err;
+
+    r = run("detect '" + sample_.string() + "' -d nosuch");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("nosuch"), std::string::npos) << r.err;
+
+    r = run("");
+    EXPECT_EQ(r.status, 2);
+}
+
+TEST_F(Cli, HelpHasAnExample) {
+    const Result r = run("detect --help");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("Examples:"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--summary-json"), std::string::npos) << r.out;
+    EXPECT_NE(run("--help").out.find("detect"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace evcorner
