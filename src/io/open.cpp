@@ -1,18 +1,57 @@
 #include "evcorner/io/open.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <string>
+
 #include "evcorner/error.hpp"
+#include "evcorner/io/aedat2_reader.hpp"
 #include "evcorner/io/text_reader.hpp"
 
 namespace evcorner::io {
 
+namespace {
+
+// The first bytes of the file, enough to hold any header's format line.
+std::string head_of(const std::string& path, std::size_t max_bytes) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return {};  // the reader reports why it cannot open the file
+    std::string s(max_bytes, '\0');
+    std::size_t got = 0;
+    while (got < max_bytes) {
+        const ssize_t n = ::read(fd, s.data() + got, max_bytes - got);
+        if (n <= 0) break;
+        got += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+    s.resize(got);
+    return s;
+}
+
+bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+
+}  // namespace
+
+std::string detect_format(const std::string& path) {
+    if (path == "-") return "ecd-text";
+    const std::string head = head_of(path, 1 << 16);
+    if (starts_with(head, "#!AER-DAT2.0")) return "aedat2";
+    return "ecd-text";
+}
+
 std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOptions options,
                                                std::string_view format) {
-    if (format == "auto" || format == "ecd-text" || format == "text") {
-        if (!options.sensor) options.sensor = kDavis240;
+    std::string fmt_name(format);
+    if (fmt_name == "auto") fmt_name = detect_format(path);
+    if (fmt_name == "ecd-text" || fmt_name == "text") {
+        if (!options.sensor) options.sensor = options.fallback_sensor;
         return std::make_unique<TextReader>(path, options);
     }
+    if (fmt_name == "aedat2" || fmt_name == "aedat") return std::make_unique<Aedat2Reader>(path, options);
     throw InputError(path == "-" ? "<stdin>" : path,
-                     "unknown input format '" + std::string(format) + "'");
+                     "unknown input format '" + fmt_name + "' (known: " + std::string(kInputFormats) + ")");
 }
 
 }  // namespace evcorner::io

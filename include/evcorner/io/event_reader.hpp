@@ -24,6 +24,10 @@ struct ReaderOptions {
     std::optional<SensorSize> sensor;
     /// Skip events outside the sensor instead of failing; they are counted.
     bool skip_invalid = false;
+    /// Sensor to validate against when neither `sensor` nor the file's metadata gives
+    /// one (text, CSV, a DAT or RAW file without geometry). nullopt: validate only
+    /// against what the format can encode, and sensor() reports nullopt.
+    std::optional<SensorSize> fallback_sensor = kDavis240;
 };
 
 /// `count` consecutive events skipped as outside the sensor, which stood just before

@@ -10,9 +10,17 @@
 
 namespace evcorner::io {
 
+/// The format names open_event_reader() accepts, besides "auto".
+inline constexpr std::string_view kInputFormats = "ecd-text, aedat2";
+
+/// Tells the format of `path` from its first bytes: "aedat2" ("#!AER-DAT2.0"), else
+/// "ecd-text". Standard input ("-") is always "ecd-text" unless forced.
+std::string detect_format(const std::string& path);
+
 /// Opens `path` ("-" = standard input) with the reader of `format` ("auto": detect).
-/// Formats without sensor metadata (text) validate against options.sensor, or the
-/// DAVIS240C's 240x180 when it is unset. Throws InputError.
+/// Formats without sensor metadata (text, files whose header has no geometry) validate
+/// against options.sensor, else options.fallback_sensor (the DAVIS240C's 240x180
+/// unless changed). Throws InputError.
 std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOptions options = {},
                                                std::string_view format = "auto");
 

@@ -1,0 +1,46 @@
+#pragma once
+// Reader for jAER's AEDAT 2.0 files (iniVation / jAER, "AER-DAT2.0"): ASCII header lines
+// starting with '#' (the first one "#!AER-DAT2.0"), then big-endian records
+// { uint32 address, uint32 timestamp [us] }. The address layout depends on the camera,
+// named by the "# AEChip:" header line:
+//   DAVIS (DAVIS240A/B/C, DAVIS346, DAVIS128, DAVIS208, DAVIS640): polarity (DVS)
+//     events have bit 31 = 0 and bit 10 = 0; x = bits 12..21, y = bits 22..30,
+//     polarity = bit 11 (1 = ON). Bit 31 = 1 (APS samples, IMU samples) and bit 10 = 1
+//     (external / special events) are skipped.
+//   DVS128 (Tmpdiff128): x = bits 1..7, y = bits 8..14, ON iff bit 0 = 0; bit 15 = 1
+//     (external events) is skipped.
+// Coordinates are returned as stored (jAER displays them mirrored; no flip is applied).
+// The 32-bit timestamp wraps every 71.6 minutes; the wrap is unrolled into int64.
+
+#include <string>
+
+#include "evcorner/io/binary_reader.hpp"
+
+namespace evcorner::io {
+
+class Aedat2Reader final : public BinaryReader {
+public:
+    enum class Layout { davis, dvs128 };
+
+    /// Opens `path` and parses its header. Throws InputError.
+    explicit Aedat2Reader(std::string path, ReaderOptions options = {});
+
+    [[nodiscard]] std::string_view format() const noexcept override { return "aedat2"; }
+    /// The "# AEChip:" header value ("" when absent).
+    [[nodiscard]] const std::string& chip() const noexcept { return chip_; }
+    [[nodiscard]] Layout layout() const noexcept { return layout_; }
+    /// Address words skipped because they are not polarity events (APS, IMU, special).
+    [[nodiscard]] std::uint64_t other_words() const noexcept { return other_words_; }
+
+private:
+    bool decode() override;
+
+    std::string chip_;
+    Layout layout_ = Layout::davis;
+    std::uint64_t other_words_ = 0;
+    std::uint32_t last_raw_t_ = 0;
+    std::int64_t epoch_ = 0;  // multiples of 2^32 us added by time wraps
+    bool have_t_ = false;
+};
+
+}  // namespace evcorner::io

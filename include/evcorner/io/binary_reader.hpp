@@ -1,0 +1,119 @@
+#pragma once
+// The part every binary event-file reader shares: a block buffer over the file with
+// the byte offset of every position, the '#'/'%' ASCII header lines such files start
+// with, and the checks each decoded event passes on its way out (sensor bounds, time
+// order), so that a format's reader is only its word decoding.
+//
+// Errors name the file and the byte offset of the offending record. Events decoded
+// before an error are returned first; the error is thrown by the next read() and by
+// every read() after it (a damaged stream is not resynchronised).
+
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "evcorner/error.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/io/event_reader.hpp"
+#include "evcorner/io/input_file.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner::io {
+
+class BinaryReader : public EventReader {
+public:
+    std::size_t read(std::span<Event> out) final;
+
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept final {
+        return skipped_in_batch_;
+    }
+    [[nodiscard]] std::uint64_t skipped() const noexcept final { return skipped_; }
+    [[nodiscard]] std::optional<SensorSize> sensor() const noexcept final { return sensor_; }
+    [[nodiscard]] const std::string& name() const noexcept final { return file_.name(); }
+    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept final { return offset(); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept final { return file_.size(); }
+    /// Events returned so far.
+    [[nodiscard]] std::uint64_t events() const noexcept { return events_; }
+
+protected:
+    BinaryReader(std::string path, ReaderOptions options);
+
+    /// Decodes events into the batch with push() until batch_full() or the end of the
+    /// data; returns false at the end. Throws (fail()) on bad input.
+    virtual bool decode() = 0;
+
+    /// Sets the sensor from the file's metadata (nullopt: it has none); options.sensor,
+    /// then options.fallback_sensor, take precedence / stand in. Call once the header
+    /// is parsed, before the first event.
+    void set_file_sensor(std::optional<SensorSize> from_file) noexcept;
+    /// Largest coordinate the format can encode, used when no sensor is known at all.
+    void set_address_limit(int side) noexcept { address_limit_ = side; }
+
+    // -- the byte buffer
+    /// Makes at least `want` bytes available (fewer only at end of file); returns how many are.
+    std::size_t fill(std::size_t want);
+    [[nodiscard]] const unsigned char* data() const noexcept {
+        return reinterpret_cast<const unsigned char*>(buf_.data()) + pos_;
+    }
+    [[nodiscard]] std::size_t available() const noexcept { return fill_ - pos_; }
+    void consume(std::size_t n) noexcept { pos_ += n; }
+    /// File offset of data().
+    [[nodiscard]] std::uint64_t offset() const noexcept { return buf_offset_ + pos_; }
+
+    /// Reads one header line if the next byte is `marker`: the line without its line
+    /// break (and '\r'). Returns false (consuming nothing) when the next byte is not
+    /// `marker` or at the end of the file.
+    bool header_line(char marker, std::string& line);
+
+    // -- the events
+    [[nodiscard]] bool batch_full() const noexcept { return n_ == out_.size(); }
+    [[nodiscard]] std::size_t batch_room() const noexcept { return out_.size() - n_; }
+    /// Validates and appends one event; `at` is the file offset of its record.
+    void push(std::int64_t t, std::uint32_t x, std::uint32_t y, bool on, std::uint64_t at) {
+        if (x >= limit_w_ || y >= limit_h_) [[unlikely]] {
+            outside(x, y, at);
+            return;
+        }
+        if (t < last_t_) [[unlikely]]
+            backwards(t, at);
+        last_t_ = t;
+        out_[n_++] = Event{t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
+                           static_cast<std::uint8_t>(on)};
+    }
+
+    [[noreturn]] void fail(std::uint64_t at, const std::string& reason) const;
+    [[nodiscard]] const ReaderOptions& options() const noexcept { return options_; }
+
+private:
+    void outside(std::uint32_t x, std::uint32_t y, std::uint64_t at);
+    [[noreturn]] void backwards(std::int64_t t, std::uint64_t at) const;
+
+    InputFile file_;
+    ReaderOptions options_;
+    std::vector<char> buf_;
+    std::size_t pos_ = 0;
+    std::size_t fill_ = 0;
+    std::uint64_t buf_offset_ = 0;  // file offset of buf_[0]
+    bool eof_ = false;
+
+    std::optional<SensorSize> sensor_;
+    int address_limit_ = kMaxSensorSide;
+    std::uint32_t limit_w_ = kMaxSensorSide;
+    std::uint32_t limit_h_ = kMaxSensorSide;
+
+    std::span<Event> out_;
+    std::size_t n_ = 0;
+    std::int64_t last_t_ = INT64_MIN;
+    std::uint64_t events_ = 0;
+    std::uint64_t skipped_ = 0;
+    std::vector<SkipRun> skipped_in_batch_;
+    std::exception_ptr error_;  // sticky: thrown by every read() once set
+    bool done_ = false;
+};
+
+}  // namespace evcorner::io
