@@ -1,0 +1,64 @@
+#pragma once
+// Arrival-ordered Surface of Active Events: for each polarity, the arrival sequence
+// number of the latest event at every pixel (1 for the first event of the stream,
+// then 2, 3, ...; 0 = never fired). Unlike timestamps, sequence numbers are unique,
+// so "the newest pixels" is always well defined: ties in time are broken by arrival.
+//
+// Each plane carries a frame of `pad` never-fired cells on every side, so that a
+// window of radius <= pad around any pixel of the sensor can be read without bounds
+// checks (cells outside the sensor read as never fired).
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "evcorner/event.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner {
+
+class ArrivalSae {
+public:
+    ArrivalSae(SensorSize size, int pad)
+        : size_(size),
+          pad_(pad),
+          stride_(static_cast<std::size_t>(size.width) + 2 * static_cast<std::size_t>(pad)),
+          plane_size_(stride_ * (static_cast<std::size_t>(size.height) + 2 * static_cast<std::size_t>(pad))),
+          cells_(2 * plane_size_, 0) {}
+
+    [[nodiscard]] SensorSize size() const noexcept { return size_; }
+    [[nodiscard]] int pad() const noexcept { return pad_; }
+    /// Distance in cells between vertically adjacent pixels.
+    [[nodiscard]] std::size_t stride() const noexcept { return stride_; }
+
+    /// Index of pixel (x, y) inside a plane (padding included).
+    [[nodiscard]] std::size_t index(int x, int y) const noexcept {
+        return (static_cast<std::size_t>(y) + pad_) * stride_ + static_cast<std::size_t>(x) + pad_;
+    }
+    [[nodiscard]] const std::uint64_t* plane(int p) const noexcept {
+        return cells_.data() + static_cast<std::size_t>(p) * plane_size_;
+    }
+    [[nodiscard]] std::uint64_t at(int p, int x, int y) const noexcept { return plane(p)[index(x, y)]; }
+
+    /// Stamps `e` with the next sequence number and returns it.
+    std::uint64_t update(const Event& e) noexcept {
+        cells_[static_cast<std::size_t>(e.p != 0) * plane_size_ + index(e.x, e.y)] = ++last_;
+        return last_;
+    }
+    /// The sequence number of the latest event (0 before the first).
+    [[nodiscard]] std::uint64_t last() const noexcept { return last_; }
+
+    [[nodiscard]] std::size_t memory_bytes() const noexcept {
+        return cells_.size() * sizeof(std::uint64_t);
+    }
+
+private:
+    SensorSize size_;
+    int pad_;
+    std::size_t stride_;
+    std::size_t plane_size_;
+    std::vector<std::uint64_t> cells_;
+    std::uint64_t last_ = 0;
+};
+
+}  // namespace evcorner

@@ -1,0 +1,59 @@
+#pragma once
+// Spatially-adaptive event-based Harris, the improved baseline of
+//   E. Mueggler, C. Bartolozzi, D. Scaramuzza, "Fast Event-based Corner Detection",
+//   BMVC 2017, Sec. 3.2 (docs/algorithms.md fixes every detail).
+// Per event: the binary w x w patch around it (w = 9) lights the Nl = 25 pixels of its
+// polarity that fired most recently in that window (distinct pixels, ties broken by
+// arrival); the event is a corner iff the Harris score of the patch is > S = 8.
+//
+// State: an arrival-ordered SAE (per pixel and polarity, the sequence number of its
+// latest event). The Nl newest pixels of a window are selected from the w*w sequence
+// numbers directly; no lists, no allocation per event.
+
+#include <cstddef>
+#include <cstdint>
+
+#include "evcorner/arrival_sae.hpp"
+#include "evcorner/detector.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/harris_score.hpp"
+#include "evcorner/scored_detector.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner {
+
+struct HarrisParams {
+    int window = 9;          ///< patch side, odd, 5..15
+    int nl = 25;             ///< newest distinct pixels lit in the patch, 1..window^2
+    double k = 0.04;         ///< Harris k
+    double threshold = 8.0;  ///< corner iff score > threshold
+};
+
+class Harris {
+public:
+    /// Throws std::invalid_argument for a parameter out of range (the message names it).
+    explicit Harris(SensorSize size, HarrisParams params = {});
+
+    /// Updates the state with `e` and answers whether `e` is a corner event.
+    /// `e` must lie on the sensor (readers validate).
+    bool process(const Event& e) noexcept;
+
+    /// Score of the latest processed event; kNoScore (NaN) for a border event, when fewer
+    /// than nl distinct pixels of its polarity have fired in its window, or before any event.
+    [[nodiscard]] double last_score() const noexcept { return score_; }
+
+    [[nodiscard]] const HarrisParams& params() const noexcept { return params_; }
+    [[nodiscard]] SensorSize size() const noexcept { return sae_.size(); }
+    [[nodiscard]] const ArrivalSae& sae() const noexcept { return sae_; }
+    [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
+
+private:
+    HarrisParams params_;
+    HarrisScorer scorer_;
+    ArrivalSae sae_;
+    int radius_;
+    double score_ = kNoScore;
+};
+static_assert(ScoredDetector<Harris>);
+
+}  // namespace evcorner
