@@ -8,6 +8,10 @@
 
 #include "evcorner/error.hpp"
 #include "evcorner/io/aedat2_reader.hpp"
+#include "evcorner/io/dat_reader.hpp"
+#include "evcorner/io/evt2_reader.hpp"
+#include "evcorner/io/evt3_reader.hpp"
+#include "evcorner/io/prophesee_header.hpp"
 #include "evcorner/io/text_reader.hpp"
 
 namespace evcorner::io {
@@ -38,6 +42,23 @@ std::string detect_format(const std::string& path) {
     if (path == "-") return "ecd-text";
     const std::string head = head_of(path, 1 << 16);
     if (starts_with(head, "#!AER-DAT2.0")) return "aedat2";
+    if (starts_with(head, "%")) {
+        // Prophesee: the '%' header names the encoding (RAW) or says "Data file" (DAT).
+        PropheseeHeader h;
+        std::size_t pos = 0;
+        while (pos < head.size() && head[pos] == '%' && !h.ended) {
+            const auto nl = head.find('\n', pos);
+            if (nl == std::string::npos) break;
+            h.add_line(std::string_view(head).substr(pos, nl - pos));
+            pos = nl + 1;
+        }
+        if (h.is_dat) return "dat";
+        if (h.evt == "3.0") return "evt3";
+        if (h.evt == "2.0") return "evt2";
+        if (!h.evt.empty())
+            throw InputError(path, "Prophesee RAW encoding EVT " + h.evt + " is not supported (EVT 2.0 and 3.0 are)");
+        throw InputError(path, "a '%' header without an 'evt' or 'format' line: pass --format evt2, evt3 or dat");
+    }
     return "ecd-text";
 }
 
@@ -50,6 +71,9 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
         return std::make_unique<TextReader>(path, options);
     }
     if (fmt_name == "aedat2" || fmt_name == "aedat") return std::make_unique<Aedat2Reader>(path, options);
+    if (fmt_name == "evt3") return std::make_unique<Evt3Reader>(path, options);
+    if (fmt_name == "evt2") return std::make_unique<Evt2Reader>(path, options);
+    if (fmt_name == "dat") return std::make_unique<DatReader>(path, options);
     throw InputError(path == "-" ? "<stdin>" : path,
                      "unknown input format '" + fmt_name + "' (known: " + std::string(kInputFormats) + ")");
 }

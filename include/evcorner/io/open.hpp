@@ -11,10 +11,13 @@
 namespace evcorner::io {
 
 /// The format names open_event_reader() accepts, besides "auto".
-inline constexpr std::string_view kInputFormats = "ecd-text, aedat2";
+inline constexpr std::string_view kInputFormats = "ecd-text, aedat2, evt2, evt3, dat";
 
-/// Tells the format of `path` from its first bytes: "aedat2" ("#!AER-DAT2.0"), else
-/// "ecd-text". Standard input ("-") is always "ecd-text" unless forced.
+/// Tells the format of `path` from its first bytes: "aedat2" ("#!AER-DAT2.0"),
+/// "evt2" / "evt3" (a Prophesee '%' header with "% evt 2.0|3.0" or "% format EVT2|EVT3"),
+/// "dat" ("% Data file containing ..."), else "ecd-text". Throws InputError for a
+/// Prophesee header that names no supported encoding. Standard input ("-") is always
+/// "ecd-text" unless forced.
 std::string detect_format(const std::string& path);
 
 /// Opens `path` ("-" = standard input) with the reader of `format` ("auto": detect).
