@@ -8,6 +8,7 @@
 
 #include "evcorner/error.hpp"
 #include "evcorner/io/aedat2_reader.hpp"
+#include "evcorner/io/csv_reader.hpp"
 #include "evcorner/io/dat_reader.hpp"
 #include "evcorner/io/evt2_reader.hpp"
 #include "evcorner/io/evt3_reader.hpp"
@@ -59,6 +60,17 @@ std::string detect_format(const std::string& path) {
             throw InputError(path, "Prophesee RAW encoding EVT " + h.evt + " is not supported (EVT 2.0 and 3.0 are)");
         throw InputError(path, "a '%' header without an 'evt' or 'format' line: pass --format evt2, evt3 or dat");
     }
+    // Text: CSV when the first line that is not a comment has a comma.
+    std::size_t pos = 0;
+    while (pos < head.size()) {
+        auto nl = head.find('\n', pos);
+        if (nl == std::string::npos) nl = head.size();
+        const std::string_view line = std::string_view(head).substr(pos, nl - pos);
+        const auto first = line.find_first_not_of(" \t\r");
+        if (first != std::string_view::npos && line[first] != '#')
+            return line.find(',') != std::string_view::npos ? "csv" : "ecd-text";
+        pos = nl + 1;
+    }
     return "ecd-text";
 }
 
@@ -71,6 +83,7 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
         return std::make_unique<TextReader>(path, options);
     }
     if (fmt_name == "aedat2" || fmt_name == "aedat") return std::make_unique<Aedat2Reader>(path, options);
+    if (fmt_name == "csv") return std::make_unique<CsvReader>(path, options);
     if (fmt_name == "evt3") return std::make_unique<Evt3Reader>(path, options);
     if (fmt_name == "evt2") return std::make_unique<Evt2Reader>(path, options);
     if (fmt_name == "dat") return std::make_unique<DatReader>(path, options);

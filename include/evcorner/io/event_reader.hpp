@@ -28,6 +28,12 @@ struct ReaderOptions {
     /// one (text, CSV, a DAT or RAW file without geometry). nullopt: validate only
     /// against what the format can encode, and sensor() reports nullopt.
     std::optional<SensorSize> fallback_sensor = kDavis240;
+    /// CSV only: the column order, a comma-separated permutation of t, x, y, p (more
+    /// names allowed, "_" ignores a column), e.g. "x,y,p,t". Empty: from the file's
+    /// header row when it has one, else "t,x,y,p".
+    std::string csv_columns;
+    /// CSV only: the unit of the t column: "us" (integers), "ns", "ms" or "s" (decimals).
+    std::string csv_time_unit = "us";
 };
 
 /// `count` consecutive events skipped as outside the sensor, which stood just before

@@ -1,0 +1,59 @@
+#pragma once
+// Reader for comma-separated event files: one event per line with the columns t, x, y,
+// p in the order ReaderOptions::csv_columns gives, or the file's header row names
+// (e.g. "x,y,p,t" as Metavision and tonic write; "timestamp", "ts", "polarity", "pol"
+// are recognised too), else t,x,y,p. t is in ReaderOptions::csv_time_unit (microseconds
+// by default; ns/ms/s are converted once, here, rounding to the nearest microsecond);
+// p is 1 or 0 (-1 also means OFF). Spaces around fields, '#' comment lines, blank lines
+// and CRLF are accepted. Errors name the file and the 1-based line.
+
+#include <array>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "evcorner/io/event_reader.hpp"
+#include "evcorner/io/input_file.hpp"
+
+namespace evcorner::io {
+
+class CsvReader final : public EventReader {
+public:
+    /// Opens `path` ("-" = standard input). Throws InputError (also for bad options).
+    explicit CsvReader(std::string path, ReaderOptions options = {});
+
+    std::size_t read(std::span<Event> out) override;
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skipped_in_batch_; }
+    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skipped_; }
+    [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
+    [[nodiscard]] std::string_view format() const noexcept override { return "csv"; }
+    [[nodiscard]] const std::string& name() const noexcept override { return file_.name(); }
+    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return file_.consumed(); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return file_.size(); }
+
+private:
+    enum Field : std::uint8_t { kT, kX, kY, kP, kIgnore };
+    bool next_line(const char*& begin, const char*& end);
+    [[noreturn]] void fail(const char* begin, const char* end, const std::string& reason) const;
+    void set_columns(const std::string& spec, bool from_header);
+    bool parse(const char* b, const char* e, Event& ev, const char*& why) const;
+
+    InputFile file_;
+    ReaderOptions options_;
+    std::optional<SensorSize> sensor_;
+    std::vector<Field> columns_;
+    int time_digits_ = 0;  // decimal digits of a microsecond in the time unit (s: 6, ms: 3, us: 0)
+    std::int64_t time_div_ = 1;  // ns: 1000
+    bool columns_known_ = false;
+    bool seen_row_ = false;  // a header row may only come first
+    std::vector<char> buf_;
+    std::size_t pos_ = 0, fill_ = 0;
+    bool eof_ = false;
+    std::uint64_t line_ = 0;
+    std::int64_t last_t_ = INT64_MIN;
+    std::uint64_t skipped_ = 0;
+    std::vector<SkipRun> skipped_in_batch_;
+    std::exception_ptr error_;
+};
+
+}  // namespace evcorner::io

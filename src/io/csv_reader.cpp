@@ -1,0 +1,247 @@
+#include "evcorner/io/csv_reader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <fmt/format.h>
+#include <utility>
+
+#include "evcorner/error.hpp"
+
+namespace evcorner::io {
+
+namespace {
+
+constexpr std::size_t kBufferSize = 1 << 20;
+constexpr std::int64_t kPow10[] = {1, 10, 100, 1000, 10000, 100000, 1000000};
+
+inline bool is_space(char c) { return c == ' ' || c == '\t'; }
+inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
+
+std::string lower_trim(std::string_view s) {
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+    std::string r(s);
+    for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (r.size() >= 2 && (r.front() == '"' || r.front() == '\'') && r.back() == r.front())
+        r = r.substr(1, r.size() - 2);
+    return r;
+}
+
+std::string quote(const char* b, const char* e) {
+    std::string s;
+    const bool cut = e - b > 80;
+    if (cut) e = b + 80;
+    for (const char* p = b; p < e; ++p) {
+        const auto c = static_cast<unsigned char>(*p);
+        s += c >= 0x20 && c < 0x7f ? std::string(1, static_cast<char>(c)) : fmt::format("\\x{:02x}", c);
+    }
+    return "'" + s + (cut ? "...'" : "'");
+}
+
+}  // namespace
+
+CsvReader::CsvReader(std::string path, ReaderOptions options)
+    : file_(std::move(path)), options_(std::move(options)), buf_(kBufferSize) {
+    sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
+    const std::string& u = options_.csv_time_unit;
+    if (u == "us") time_digits_ = 0;
+    else if (u == "ms") time_digits_ = 3;
+    else if (u == "s") time_digits_ = 6;
+    else if (u == "ns") time_div_ = 1000;
+    else throw InputError(file_.name(), "unknown CSV time unit '" + u + "' (us, ns, ms or s)");
+    if (!options_.csv_columns.empty()) set_columns(options_.csv_columns, false);
+}
+
+void CsvReader::set_columns(const std::string& spec, bool from_header) {
+    std::vector<Field> cols;
+    std::array<int, 4> seen{};
+    std::size_t start = 0;
+    for (;;) {
+        const auto comma = spec.find(',', start);
+        const std::string name = lower_trim(std::string_view(spec).substr(start, comma - start));
+        Field f = kIgnore;
+        if (name == "t" || name == "ts" || name == "timestamp" || name == "time" || name == "t_us") f = kT;
+        else if (name == "x") f = kX;
+        else if (name == "y") f = kY;
+        else if (name == "p" || name == "pol" || name == "polarity") f = kP;
+        else if (!from_header && name != "_")
+            throw InputError(file_.name(), "unknown CSV column '" + name + "' in '" + spec +
+                                               "' (t, x, y, p, or _ to ignore one)");
+        if (f != kIgnore && seen[f]++ > 0)
+            throw InputError(file_.name(), "CSV column '" + name + "' named twice in '" + spec + "'");
+        cols.push_back(f);
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    if (std::count(seen.begin(), seen.end(), 1) != 4) {
+        const std::string why = "CSV columns '" + spec + "' do not name each of t, x, y and p";
+        if (from_header) throw InputError(file_.name(), InputError::Unit::line, line_, why);
+        throw InputError(file_.name(), why);
+    }
+    columns_ = std::move(cols);
+    columns_known_ = true;
+}
+
+void CsvReader::fail(const char* begin, const char* end, const std::string& reason) const {
+    throw InputError(file_.name(), InputError::Unit::line, line_, reason + ": " + quote(begin, end));
+}
+
+bool CsvReader::next_line(const char*& begin, const char*& end) {
+    for (;;) {
+        const char* data = buf_.data();
+        const void* nl = std::memchr(data + pos_, '\n', fill_ - pos_);
+        if (nl != nullptr || (eof_ && pos_ < fill_)) {
+            begin = data + pos_;
+            end = nl ? static_cast<const char*>(nl) : data + fill_;
+            pos_ = static_cast<std::size_t>(end - data) + (nl ? 1 : 0);
+            ++line_;
+            if (end > begin && end[-1] == '\r') --end;
+            return true;
+        }
+        if (eof_) return false;
+        if (pos_ == 0 && fill_ == buf_.size()) {
+            ++line_;
+            fail(data, data + 80, fmt::format("line longer than {} bytes", buf_.size()));
+        }
+        std::memmove(buf_.data(), buf_.data() + pos_, fill_ - pos_);
+        fill_ -= pos_;
+        pos_ = 0;
+        const std::size_t n = file_.read(std::span<char>(buf_.data() + fill_, buf_.size() - fill_));
+        if (n == 0) eof_ = true;
+        fill_ += n;
+    }
+}
+
+bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& why) const {
+    std::size_t col = 0;
+    for (;; ++col) {
+        if (col >= columns_.size()) {
+            why = "more columns than the column order names";
+            return false;
+        }
+        while (p < end && is_space(*p)) ++p;
+        const char* f = p;
+        while (p < end && *p != ',') ++p;
+        const char* fe = p;
+        while (fe > f && is_space(fe[-1])) --fe;
+        const Field kind = columns_[col];
+        if (kind == kT) {
+            const char* q = f;
+            const bool neg = q < fe && *q == '-';
+            if (q < fe && (*q == '-' || *q == '+')) ++q;
+            std::int64_t ip = 0;
+            int digits = 0;
+            while (q < fe && is_digit(*q)) {
+                ip = ip * 10 + (*q++ - '0');
+                if (++digits > 18) {
+                    why = "timestamp too large";
+                    return false;
+                }
+            }
+            std::int64_t frac = 0;  // the first time_digits_ + 1 fractional digits
+            int fd = 0;
+            if (q < fe && *q == '.') {
+                ++q;
+                while (q < fe && is_digit(*q)) {
+                    if (fd <= time_digits_) frac = frac * 10 + (*q - '0');
+                    ++fd;
+                    ++q;
+                }
+            }
+            if (q != fe || (digits == 0 && fd == 0)) {
+                why = "expected a timestamp";
+                return false;
+            }
+            if (ip > INT64_MAX / kPow10[time_digits_] / 2) {
+                why = "timestamp too large";
+                return false;
+            }
+            for (int d = std::min(fd, time_digits_ + 1); d <= time_digits_; ++d) frac *= 10;
+            // frac now holds time_digits_ + 1 digits: the last one rounds (halves away from zero).
+            std::int64_t us = ip * kPow10[time_digits_] + frac / 10 + (frac % 10 >= 5 ? 1 : 0);
+            if (time_div_ > 1) us = (ip + time_div_ / 2) / time_div_;
+            ev.t = neg ? -us : us;
+        } else if (kind == kX || kind == kY) {
+            std::uint32_t v = 0;
+            const char* q = f;
+            if (q == fe) {
+                why = kind == kX ? "expected x, a non-negative integer" : "expected y, a non-negative integer";
+                return false;
+            }
+            for (; q < fe; ++q) {
+                if (!is_digit(*q) || (v = v * 10 + static_cast<std::uint32_t>(*q - '0')) >= 65536) {
+                    why = kind == kX ? "x is not an integer in 0..65535" : "y is not an integer in 0..65535";
+                    return false;
+                }
+            }
+            (kind == kX ? ev.x : ev.y) = static_cast<std::uint16_t>(v);
+        } else if (kind == kP) {
+            const std::size_t len = static_cast<std::size_t>(fe - f);
+            if (len == 1 && (*f == '0' || *f == '1')) ev.p = static_cast<std::uint8_t>(*f - '0');
+            else if (len == 2 && f[0] == '-' && f[1] == '1') ev.p = 0;
+            else if (len == 4 && std::memcmp(f, "True", 4) == 0) ev.p = 1;
+            else if (len == 5 && std::memcmp(f, "False", 5) == 0) ev.p = 0;
+            else {
+                why = "polarity must be 1 or 0 (or -1)";
+                return false;
+            }
+        }
+        if (p == end) break;
+        ++p;  // the comma
+    }
+    if (col + 1 != columns_.size()) {
+        why = "fewer columns than the column order names";
+        return false;
+    }
+    return true;
+}
+
+std::size_t CsvReader::read(std::span<Event> out) {
+    skipped_in_batch_.clear();
+    if (error_) std::rethrow_exception(error_);
+    std::size_t n = 0;
+    try {
+        const char* b;
+        const char* e;
+        while (n < out.size() && next_line(b, e)) {
+            const char* q = b;
+            while (q < e && is_space(*q)) ++q;
+            if (q == e || *q == '#') continue;
+            if (!is_digit(*q) && *q != '-' && *q != '+' && *q != '.') {
+                // A header row: names the columns unless the options did.
+                if (seen_row_) fail(b, e, "text where an event was expected");
+                seen_row_ = true;
+                if (options_.csv_columns.empty()) set_columns(std::string(b, e), true);
+                continue;
+            }
+            if (!columns_known_) set_columns("t,x,y,p", false);
+            seen_row_ = true;
+            Event ev{};
+            const char* why = nullptr;
+            if (!parse(b, e, ev, why)) fail(b, e, why);
+            if (ev.t < last_t_)
+                fail(b, e, fmt::format("timestamp goes backwards ({} us before the previous event)", last_t_ - ev.t));
+            if (sensor_ && !sensor_->contains(ev)) {
+                if (!options_.skip_invalid)
+                    fail(b, e, fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, "
+                                           "or --skip-invalid to skip such events)",
+                                           ev.x, ev.y, sensor_->width, sensor_->height));
+                ++skipped_;
+                if (!skipped_in_batch_.empty() && skipped_in_batch_.back().before == n)
+                    ++skipped_in_batch_.back().count;
+                else
+                    skipped_in_batch_.push_back({n, 1});
+                continue;
+            }
+            last_t_ = ev.t;
+            out[n++] = ev;
+        }
+    } catch (const InputError&) {
+        error_ = std::current_exception();
+        if (n == 0 && skipped_in_batch_.empty()) throw;
+    }
+    return n;
+}
+
+}  // namespace evcorner::io
