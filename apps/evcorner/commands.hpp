@@ -2,9 +2,15 @@
 // The subcommands of the evcorner tool; each adds itself to the application.
 
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace evcorner::cli {
 
 void add_detect_command(CLI::App& app);
+void add_info_command(CLI::App& app);
+void add_convert_command(CLI::App& app);
+
+/// The input-format options that info and convert share (--format, --csv-columns, --time-unit).
+void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit);
 
 }  // namespace evcorner::cli

@@ -17,8 +17,12 @@ int main(int argc, char** argv) {
     app.footer(
         "Example:\n"
         "  evcorner detect events.txt -o corners.txt     # Event-Camera-Dataset text in and out\n"
+        "  evcorner info recording.aedat                 # what a file holds (AEDAT2, EVT2/3, DAT, CSV, npy)\n"
+        "  evcorner convert recording.raw events.npy     # any readable format to text, CSV or npy\n"
         "Exit status: 0 on success, 1 on bad input or a failed write, 2 on a usage error.");
     evcorner::cli::add_detect_command(app);
+    evcorner::cli::add_info_command(app);
+    evcorner::cli::add_convert_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -12,6 +12,7 @@
 #include "evcorner/io/dat_reader.hpp"
 #include "evcorner/io/evt2_reader.hpp"
 #include "evcorner/io/evt3_reader.hpp"
+#include "evcorner/io/npy.hpp"
 #include "evcorner/io/prophesee_header.hpp"
 #include "evcorner/io/text_reader.hpp"
 
@@ -43,6 +44,7 @@ std::string detect_format(const std::string& path) {
     if (path == "-") return "ecd-text";
     const std::string head = head_of(path, 1 << 16);
     if (starts_with(head, "#!AER-DAT2.0")) return "aedat2";
+    if (starts_with(head, "\x93NUMPY")) return "npy";
     if (starts_with(head, "%")) {
         // Prophesee: the '%' header names the encoding (RAW) or says "Data file" (DAT).
         PropheseeHeader h;
@@ -86,6 +88,7 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
     if (fmt_name == "csv") return std::make_unique<CsvReader>(path, options);
     if (fmt_name == "evt3") return std::make_unique<Evt3Reader>(path, options);
     if (fmt_name == "evt2") return std::make_unique<Evt2Reader>(path, options);
+    if (fmt_name == "npy") return std::make_unique<NpyReader>(path, options);
     if (fmt_name == "dat") return std::make_unique<DatReader>(path, options);
     throw InputError(path == "-" ? "<stdin>" : path,
                      "unknown input format '" + fmt_name + "' (known: " + std::string(kInputFormats) + ")");

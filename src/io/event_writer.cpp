@@ -1,0 +1,54 @@
+#include "evcorner/io/event_writer.hpp"
+
+#include "evcorner/error.hpp"
+#include "evcorner/io/csv_writer.hpp"
+#include "evcorner/io/npy.hpp"
+#include "evcorner/io/text_writer.hpp"
+
+namespace evcorner::io {
+
+namespace {
+
+class TextEventWriter final : public EventWriter {
+public:
+    explicit TextEventWriter(std::string path) : w_(std::move(path)) {}
+    void write(std::span<const Event> events) override { w_.write(events); }
+    void close() override { w_.close(); }
+    [[nodiscard]] const std::string& name() const noexcept override { return w_.name(); }
+
+private:
+    TextWriter w_;
+};
+
+bool ends_with(const std::string& s, std::string_view suffix) {
+    if (s.size() < suffix.size()) return false;
+    for (std::size_t i = 0; i < suffix.size(); ++i) {
+        const char c = s[s.size() - suffix.size() + i];
+        if ((c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c) != suffix[i]) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+std::string output_format_for(const std::string& path) {
+    if (ends_with(path, ".txt")) return "ecd-text";
+    if (ends_with(path, ".csv")) return "csv";
+    if (ends_with(path, ".npy")) return "npy";
+    return "";
+}
+
+std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format) {
+    std::string f(format);
+    if (f == "auto") {
+        f = output_format_for(path);
+        if (f.empty()) f = "ecd-text";
+    }
+    if (f == "ecd-text" || f == "text") return std::make_unique<TextEventWriter>(path);
+    if (f == "csv") return std::make_unique<CsvWriter>(path);
+    if (f == "npy") return std::make_unique<NpyWriter>(path);
+    throw OutputError(path == "-" ? "<stdout>" : path,
+                      "unknown output format '" + f + "' (known: " + std::string(kOutputFormats) + ")");
+}
+
+}  // namespace evcorner::io
