@@ -1,6 +1,6 @@
 #include "evcorner/harris.hpp"
 
-#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -8,6 +8,8 @@
 namespace evcorner {
 
 namespace {
+
+constexpr int kBuckets = 65;  // bit width of an age: 0..64
 
 HarrisParams validated(HarrisParams p) {
     // The window and k are checked by HarrisScorer; nl depends on the window.
@@ -36,25 +38,63 @@ bool Harris::process(const Event& e) noexcept {
     if (e.x < radius_ || e.x > s.width - radius_ || e.y < radius_ || e.y > s.height - radius_)
         return false;
 
+    // Select the nl newest fired pixels of the window without sorting: bucket every
+    // cell by the bit width of its age in arrivals (octaves, monotone in age; a cell that
+    // never fired has age `now`, the oldest), find the bucket where the count of newer
+    // cells reaches nl, light every cell of the newer buckets and rank the few cells of
+    // that boundary bucket exactly. Branch-free loops; four interleaved histograms so that
+    // runs of one bucket do not chain their increments.
     const int w = params_.window;
-    const std::uint64_t* row = sae_.plane(e.p != 0) + sae_.index(e.x - radius_, e.y - radius_);
-    // Key = sequence number above the (row, column) of the pixel; sequence numbers are
-    // unique, so the keys order the fired pixels by arrival.
+    const int nl = params_.nl;
+    const std::uint64_t now = sae_.last();
+    const std::uint64_t* const first = sae_.plane(e.p != 0) + sae_.index(e.x - radius_, e.y - radius_);
+    std::uint8_t bucket[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
+    std::uint8_t histogram[4][kBuckets] = {};
+    int fired = 0;
+    const std::uint64_t* row = first;
+    for (int r = 0, i = 0; r < w; ++r, row += sae_.stride())
+        for (int c = 0; c < w; ++c, ++i) {
+            const std::uint64_t seq = row[c];
+            const auto b = static_cast<std::uint8_t>(std::bit_width(now - seq));
+            bucket[i] = b;
+            ++histogram[i & 3][b];
+            fired += seq != 0;
+        }
+    if (fired < nl) return false;  // fewer than nl pixels ever fired in the window
+
+    int boundary = 0, newer = 0;  // newer: cells in buckets below `boundary`
+    for (;;) {
+        const int here = histogram[0][boundary] + histogram[1][boundary] + histogram[2][boundary] +
+                         histogram[3][boundary];
+        if (newer + here >= nl) break;
+        newer += here;
+        ++boundary;
+    }
+
+    std::uint16_t rows[HarrisScorer::kMaxWindow];
+    // The boundary bucket's keys: sequence number above the patch position, unique.
     std::uint64_t keys[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
     int m = 0;
-    for (int r = 0; r < w; ++r, row += sae_.stride())
-        for (int c = 0; c < w; ++c) {
-            const std::uint64_t seq = row[c];
-            keys[m] = seq << 8 | static_cast<std::uint64_t>(r << 4 | c);
-            m += seq != 0;
+    row = first;
+    for (int r = 0, i = 0; r < w; ++r, row += sae_.stride()) {
+        unsigned lit = 0;
+        for (int c = 0; c < w; ++c, ++i) {
+            lit |= static_cast<unsigned>(bucket[i] < boundary) << c;
+            keys[m] = row[c] << 8 | static_cast<std::uint64_t>(r << 4 | c);
+            m += bucket[i] == boundary;
         }
-    const int nl = params_.nl;
-    if (m < nl) return false;
-    std::uint64_t* newest = keys + (m - nl);
-    if (m > nl) std::nth_element(keys, newest, keys + m);
-
-    std::uint16_t rows[HarrisScorer::kMaxWindow] = {};
-    for (int i = 0; i < nl; ++i) rows[newest[i] >> 4 & 15] |= static_cast<std::uint16_t>(1u << (newest[i] & 15));
+        rows[r] = static_cast<std::uint16_t>(lit);
+    }
+    // The `take` newest keys of the boundary bucket are those with fewer than `take` newer
+    // keys there. (Cells that never fired have key < 2^8, below every fired cell's, and
+    // fired >= nl guarantees they are never taken.)
+    const int take = nl - newer;  // 1..m
+    for (int j = 0; j < m; ++j) {
+        int rank = 0;
+        for (int k = 0; k < m; ++k) rank += keys[k] > keys[j];
+        const std::uint64_t key = keys[j];
+        rows[key >> 4 & 15] |= static_cast<std::uint16_t>(static_cast<unsigned>(rank < take) << (key & 15));
+    }
     score_ = scorer_.score(rows);
     return score_ > params_.threshold;
 }

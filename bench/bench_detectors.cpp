@@ -1,0 +1,85 @@
+// ns/event of each detector on each real Event-Camera-Dataset cut (files loaded once,
+// before timing). Run with --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// for medians. Without ../shared, falls back to the bundled shapes_translation sample.
+
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "evcorner/detector.hpp"
+#include "evcorner/efast.hpp"
+#include "evcorner/harris.hpp"
+#include "evcorner/harris_global.hpp"
+#include "evcorner/io/text_reader.hpp"
+
+namespace fs = std::filesystem;
+using namespace evcorner;
+
+namespace {
+
+struct Input {
+    std::string name;
+    std::vector<Event> events;
+};
+
+std::vector<Input> load_inputs() {
+    std::vector<Input> inputs;
+    const fs::path real = fs::path(EVCORNER_SHARED_DIR) / "data" / "real";
+    if (fs::is_directory(real / "ecd-stppp")) {
+        for (const char* seq : {"boxes_rotation", "boxes_translation", "dynamic_rotation", "dynamic_translation",
+                                "poster_rotation", "poster_translation", "shapes_rotation", "shapes_translation"})
+            inputs.push_back({seq, io::read_text_file((real / "ecd-stppp" / seq / "events.txt").string())});
+        inputs.push_back({"slider_depth",
+                          io::read_text_file((real / "ecd-slider-depth-eventsviz/slider_depth/events_chunk.txt").string())});
+    } else {
+        inputs.push_back({"bundled_shapes_translation",
+                          io::read_text_file((fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt").string())});
+    }
+    return inputs;
+}
+
+// A fresh detector per pass, so that every pass sees the same stream from the start;
+// its construction is outside the timing.
+template <class Make>
+void run(benchmark::State& state, const Input* in, Make make) {
+    std::vector<std::uint8_t> flags(in->events.size());
+    std::size_t corners = 0;
+    for (auto _ : state) {
+        state.PauseTiming();
+        auto det = make();
+        state.ResumeTiming();
+        corners = detect(det, in->events, flags);
+        benchmark::DoNotOptimize(corners);
+    }
+    const double n = static_cast<double>(in->events.size());
+    // Seconds per event (printed with an SI prefix: "250n" = 250 ns/event).
+    state.counters["time_per_event"] = benchmark::Counter(
+        n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.counters["corners"] = static_cast<double>(corners);
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * in->events.size()));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    static const std::vector<Input> inputs = load_inputs();
+    for (const Input& in : inputs) {
+        benchmark::RegisterBenchmark(("efast/" + in.name).c_str(), [&in](benchmark::State& s) {
+            run(s, &in, [] { return EFast(kDavis240); });
+        })->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("harris/" + in.name).c_str(), [&in](benchmark::State& s) {
+            run(s, &in, [] { return Harris(kDavis240); });
+        })->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(("harris_global/" + in.name).c_str(), [&in](benchmark::State& s) {
+            run(s, &in, [] { return HarrisGlobal(kDavis240); });
+        })->Unit(benchmark::kMillisecond);
+    }
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
