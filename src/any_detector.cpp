@@ -2,22 +2,33 @@
 
 #include <array>
 #include <stdexcept>
+#include <type_traits>
+
+#include "evcorner/scored_detector.hpp"
 
 namespace evcorner {
 
 namespace {
 constexpr std::array kInfos{
     DetectorInfo{"efast", "eFAST (Mueggler et al., BMVC 2017): arcs on the SAE circles of radius 3 and 4"},
+    DetectorInfo{"harris", "spatially-adaptive Harris (Mueggler et al., BMVC 2017, Sec. 3.2): newest Nl pixels of the window"},
+    DetectorInfo{"harris-global", "event-based Harris (Vasco et al., IROS 2016): newest N pixels of the sensor"},
 };
 }  // namespace
 
 std::span<const DetectorInfo> detector_infos() noexcept { return kInfos; }
 
-AnyDetector make_detector(std::string_view name, SensorSize size) {
+AnyDetector make_detector(std::string_view name, SensorSize size, const DetectorParams& params) {
     if (name == "efast") return EFast(size);
+    if (name == "harris") return Harris(size, params.harris);
+    if (name == "harris-global") return HarrisGlobal(size, params.harris_global);
     std::string known;
     for (const auto& i : kInfos) known += (known.empty() ? "" : ", ") + std::string(i.name);
     throw std::invalid_argument("unknown detector '" + std::string(name) + "' (known: " + known + ")");
+}
+
+bool has_score(const AnyDetector& d) noexcept {
+    return std::visit([](const auto& det) { return ScoredDetector<std::decay_t<decltype(det)>>; }, d);
 }
 
 std::size_t memory_bytes(const AnyDetector& d) noexcept {

@@ -19,6 +19,7 @@
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/text_writer.hpp"
+#include "evcorner/scored_detector.hpp"
 #include "progress.hpp"
 
 namespace evcorner::cli {
@@ -36,6 +37,8 @@ struct DetectOptions {
     std::string mask;
     std::string summary_json;
     bool skip_invalid = false;
+    bool with_score = false;
+    DetectorParams params;
     bool quiet = false;
     bool no_progress = false;
 };
@@ -113,7 +116,10 @@ void run_detect(const DetectOptions& o) {
     io::EventReader& reader = *source;
     const SensorSize size = reader.sensor().value_or(kDavis240);
 
-    AnyDetector detector = make_detector(o.detector, size);
+    AnyDetector detector = make_detector(o.detector, size, o.params);
+    if (o.with_score && !has_score(detector))
+        throw std::invalid_argument("--with-score: detector '" + o.detector +
+                                    "' has no score (harris and harris-global have one)");
     io::TextWriter corners_out(o.output);
     std::unique_ptr<io::OutputFile> mask_out;
     if (!o.mask.empty()) mask_out = std::make_unique<io::OutputFile>(o.mask);
@@ -121,6 +127,7 @@ void run_detect(const DetectOptions& o) {
     Progress progress(!o.quiet && !o.no_progress, reader.bytes_total());
     std::vector<Event> events(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
+    std::vector<double> scores(o.with_score ? kBatch : 0);
     Totals totals;
 
     // Every batch read is detected and written before the next read, so an input
@@ -137,13 +144,25 @@ void run_detect(const DetectOptions& o) {
                     const auto skips = reader.skipped_in_batch();
                     if (n == 0 && skips.empty()) break;
                     const auto t0 = Clock::now();
-                    const std::size_t c =
-                        detect(det, std::span<const Event>(events.data(), n), flags);
+                    std::size_t c = 0;
+                    if constexpr (ScoredDetector<std::decay_t<decltype(det)>>) {
+                        if (o.with_score)
+                            c = detect(det, std::span<const Event>(events.data(), n), flags, scores);
+                        else
+                            c = detect(det, std::span<const Event>(events.data(), n), flags);
+                    } else {
+                        c = detect(det, std::span<const Event>(events.data(), n), flags);
+                    }
                     totals.detect_s += std::chrono::duration<double>(Clock::now() - t0).count();
                     totals.events += n;
                     totals.corners += c;
                     for (std::size_t i = 0; i < n; ++i)
-                        if (flags[i]) corners_out.write(events[i]);
+                        if (flags[i]) {
+                            if (o.with_score)
+                                corners_out.write(events[i], scores[i]);
+                            else
+                                corners_out.write(events[i]);
+                        }
                     if (mask_out) write_mask(*mask_out, flags, n, skips);
                     progress.update(reader.bytes_consumed(), totals.events);
                 }
@@ -173,7 +192,7 @@ void run_detect(const DetectOptions& o) {
 void add_detect_command(CLI::App& app) {
     auto o = std::make_shared<DetectOptions>();
     std::string detectors;
-    for (const auto& d : detector_infos()) detectors += fmt::format("\n  {:<8} {}", d.name, d.summary);
+    for (const auto& d : detector_infos()) detectors += fmt::format("\n  {:<13} {}", d.name, d.summary);
 
     CLI::App* cmd = app.add_subcommand(
         "detect",
@@ -204,6 +223,22 @@ void add_detect_command(CLI::App& app) {
     cmd->add_option("--summary-json", o->summary_json,
                     "Also write the summary as JSON (keys include events, corners, "
                     "reduction_rate [%], ns_per_event)");
+    cmd->add_flag("--with-score", o->with_score,
+                  "Append the detector's score to each corner line ('t x y p score'); harris and "
+                  "harris-global only");
+    cmd->add_option("--harris-window", o->params.harris.window,
+                    "Harris (both): patch side, odd, 5..15 [default: 9]")
+        ->check(CLI::Range(5, 15));
+    cmd->add_option("--harris-nl", o->params.harris.nl,
+                    "harris: newest distinct pixels lit in the patch, 1..window^2 [default: 25]")
+        ->check(CLI::Range(1, 225));
+    cmd->add_option("--harris-n", o->params.harris_global.n,
+                    "harris-global: newest distinct pixels lit over the sensor per polarity "
+                    "(1000 or 2000 in Vasco et al.) [default: 1000]")
+        ->check(CLI::Range(1, 2147483647));
+    cmd->add_option("--harris-k", o->params.harris.k, "Harris (both): k in H = det - k trace^2 [default: 0.04]");
+    cmd->add_option("--harris-threshold", o->params.harris.threshold,
+                    "Harris (both): corner iff score > threshold [default: 8]");
     cmd->add_flag("--skip-invalid", o->skip_invalid,
                   "Skip events outside the sensor (counted in the summary) instead of failing");
     cmd->add_flag("-q,--quiet", o->quiet, "No summary and no progress bar");
@@ -212,8 +247,16 @@ void add_detect_command(CLI::App& app) {
         "Examples:\n"
         "  evcorner detect events.txt -o corners.txt\n"
         "  evcorner detect events.txt --mask is_corner.txt --summary-json summary.json > corners.txt\n"
+        "  evcorner detect events.txt -d harris --with-score | head\n"
+        "  evcorner detect events.txt -d harris-global --harris-n 2000\n"
         "  cat events.txt | evcorner detect - --size 346x260 | head");
-    cmd->callback([o] { run_detect(*o); });
+    cmd->callback([o] {
+        // --harris-window, -k and -threshold apply to both Harris detectors.
+        o->params.harris_global.window = o->params.harris.window;
+        o->params.harris_global.k = o->params.harris.k;
+        o->params.harris_global.threshold = o->params.harris.threshold;
+        run_detect(*o);
+    });
 }
 
 }  // namespace evcorner::cli

@@ -7,7 +7,10 @@
 //                                          pixels, no event yet).
 
 #include <concepts>
+#include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <span>
 
 #include "evcorner/detector.hpp"
 
@@ -20,5 +23,20 @@ template <class D>
 concept ScoredDetector = Detector<D> && requires(const D& d) {
     { d.last_score() } noexcept -> std::same_as<double>;
 };
+
+/// detect() that also keeps the scores: score[i] = the detector's last_score() after
+/// events[i]. is_corner and score must be at least as long as events.
+template <ScoredDetector D>
+std::size_t detect(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                   std::span<double> score) noexcept {
+    std::size_t corners = 0;
+    for (std::size_t i = 0; i < events.size(); ++i) {
+        const bool c = det.process(events[i]);
+        is_corner[i] = static_cast<std::uint8_t>(c);
+        score[i] = det.last_score();
+        corners += c;
+    }
+    return corners;
+}
 
 }  // namespace evcorner

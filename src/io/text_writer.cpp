@@ -1,5 +1,6 @@
 #include "evcorner/io/text_writer.hpp"
 
+#include <charconv>
 #include <cstdint>
 
 namespace evcorner::io {
@@ -46,6 +47,21 @@ std::size_t format_text_line(const Event& e, char* dst) noexcept {
     *p++ = static_cast<char>('0' + (e.p != 0));
     *p++ = '\n';
     return static_cast<std::size_t>(p - dst);
+}
+
+std::size_t format_text_line(const Event& e, double score, char* dst) noexcept {
+    std::size_t n = format_text_line(e, dst) - 1;  // without its '\n'
+    dst[n++] = ' ';
+    // 10 significant digits fit in 32 bytes ("-1.234567891e-308").
+    const auto res = std::to_chars(dst + n, dst + kMaxScoredTextLine - 1, score, std::chars_format::general, 10);
+    n = static_cast<std::size_t>(res.ptr - dst);
+    dst[n++] = '\n';
+    return n;
+}
+
+void TextWriter::write(const Event& e, double score) {
+    char* dst = out_.reserve(kMaxScoredTextLine);
+    out_.commit(format_text_line(e, score, dst));
 }
 
 void TextWriter::write(const Event& e) {

@@ -17,6 +17,9 @@ public:
     explicit TextWriter(std::string path) : out_(std::move(path)) {}
 
     void write(const Event& e);
+    /// Writes "t x y p score": the event's line with a score appended (10 significant
+    /// digits, shortest form; "nan" when there is none).
+    void write(const Event& e, double score);
     void write(std::span<const Event> events) {
         for (const Event& e : events) write(e);
     }
@@ -31,5 +34,8 @@ private:
 /// at least kMaxTextLine bytes; returns the number of bytes written.
 inline constexpr std::size_t kMaxTextLine = 64;
 std::size_t format_text_line(const Event& e, char* dst) noexcept;
+/// The same line with " score" before the '\n'; `dst` must hold kMaxScoredTextLine bytes.
+inline constexpr std::size_t kMaxScoredTextLine = kMaxTextLine + 32;
+std::size_t format_text_line(const Event& e, double score, char* dst) noexcept;
 
 }  // namespace evcorner::io
