@@ -20,13 +20,15 @@ bool EFast::process(const Event& e) noexcept {
 
     const std::int64_t* centre =
         sae_.plane(e.p) + static_cast<std::ptrdiff_t>(e.y) * s.width + e.x;
-    std::array<std::int64_t, kCircle3.size()> t3;
-    for (std::size_t k = 0; k < t3.size(); ++k) t3[k] = centre[off3_[k]];
-    if (!arc_fires<16, kArc3Min, kArc3Max>(t3.data())) return false;
+    constexpr int n3 = kCircle3.size();
+    constexpr int n4 = kCircle4.size();
+    std::array<std::int64_t, 2 * n3> t3;  // the circle twice: arcs never wrap
+    for (int k = 0; k < n3; ++k) t3[k] = t3[k + n3] = centre[off3_[k]];
+    if (!arc_fires<n3, kArc3Min, kArc3Max>(t3.data())) return false;
 
-    std::array<std::int64_t, kCircle4.size()> t4;
-    for (std::size_t k = 0; k < t4.size(); ++k) t4[k] = centre[off4_[k]];
-    return arc_fires<20, kArc4Min, kArc4Max>(t4.data());
+    std::array<std::int64_t, 2 * n4> t4;
+    for (int k = 0; k < n4; ++k) t4[k] = t4[k + n4] = centre[off4_[k]];
+    return arc_fires<n4, kArc4Min, kArc4Max>(t4.data());
 }
 
 }  // namespace evcorner

@@ -19,7 +19,7 @@ void compare_on_random_circles(int value_range, int trials, std::uint32_t seed) 
         std::array<std::int64_t, N> t;
         for (auto& v : t) v = value(rng);
         const bool naive = arc_fires_naive<N, Lmin, Lmax>(t);
-        ASSERT_EQ((arc_fires<N, Lmin, Lmax>(t.data())), naive) << "trial " << trial;
+        ASSERT_EQ((arc_fires<N, Lmin, Lmax>(t)), naive) << "trial " << trial;
         fired += naive;
     }
     // Both outcomes must have been exercised, or the comparison proves little.
@@ -43,7 +43,7 @@ void arcs_of_every_length() {
             // All equal inside, so no shorter sub-arc is strictly newer than the rest.
             for (int i = 0; i < len; ++i) t[(start + i) % N] = 20;
             const bool expected = len >= Lmin && len <= Lmax;
-            EXPECT_EQ((arc_fires<N, Lmin, Lmax>(t.data())), expected) << "len " << len << " start " << start;
+            EXPECT_EQ((arc_fires<N, Lmin, Lmax>(t)), expected) << "len " << len << " start " << start;
             EXPECT_EQ((arc_fires_naive<N, Lmin, Lmax>(t)), expected) << "len " << len << " start " << start;
         }
     }
@@ -57,25 +57,25 @@ TEST(ArcTest, ArcTiedWithTheRestDoesNotFire) {
     t[3] = t[4] = t[5] = 9;
     t[6] = 7;  // arc 3..6 has oldest 7
     t[12] = 7;  // the rest ties with it: 3..6 does not fire; 3..5 is newer than all (9 > 7)
-    EXPECT_TRUE((arc_fires<16, 3, 6>(t.data())));
+    EXPECT_TRUE((arc_fires<16, 3, 6>(t)));
     t[12] = 9;  // now a pixel outside ties with the arc's newest: nothing of length 3..6 fires
-    EXPECT_FALSE((arc_fires<16, 3, 6>(t.data())));
+    EXPECT_FALSE((arc_fires<16, 3, 6>(t)));
     EXPECT_FALSE((arc_fires_naive<16, 3, 6>(t)));
 }
 
 TEST(ArcTest, AllEqualNeverFires) {
     std::array<std::int64_t, 20> t;
     t.fill(INT64_MIN);
-    EXPECT_FALSE((arc_fires<20, 4, 8>(t.data())));
+    EXPECT_FALSE((arc_fires<20, 4, 8>(t)));
     t.fill(42);
-    EXPECT_FALSE((arc_fires<20, 4, 8>(t.data())));
+    EXPECT_FALSE((arc_fires<20, 4, 8>(t)));
 }
 
 TEST(ArcTest, ArcAcrossTheWrapFires) {
     std::array<std::int64_t, 16> t;
     t.fill(0);
     t[14] = t[15] = t[0] = t[1] = 100;  // 4 pixels across index 0
-    EXPECT_TRUE((arc_fires<16, 3, 6>(t.data())));
+    EXPECT_TRUE((arc_fires<16, 3, 6>(t)));
 }
 
 }  // namespace

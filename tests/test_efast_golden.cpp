@@ -14,7 +14,7 @@ namespace evcorner {
 namespace {
 
 std::vector<std::uint64_t> efast_corner_positions(const std::string& events_file) {
-    const auto events = io::read_text_file(events_file, {.sensor = kDavis240});
+    const auto events = io::read_text_file(events_file);
     EFast det(kDavis240);
     std::vector<std::uint8_t> flags(events.size());
     detect(det, std::span<const Event>(events), flags);

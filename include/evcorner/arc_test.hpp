@@ -18,45 +18,82 @@
 
 namespace evcorner {
 
+namespace detail {
+// #values in t[0..N) that are >= v. Kept scalar on purpose: without SSE4.2 the
+// auto-vectorised 64-bit compare costs several times more instructions.
+template <int N>
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-vectorize")))
+#endif
+inline int count_at_least(const std::int64_t* t, std::int64_t v) noexcept {
+    int n = 0;
+    for (int k = 0; k < N; ++k) n += t[k] >= v;
+    return n;
+}
+}  // namespace detail
+
+/// `t` holds the circle twice: t[k] == t[k + N] for 0 <= k < N, so that no index
+/// along an arc needs a modulo.
 template <int N, int Lmin, int Lmax>
 [[nodiscard]] inline bool arc_fires(const std::int64_t* t) noexcept {
-    static_assert(1 <= Lmin && Lmin <= Lmax && Lmax < N);
+    static_assert(2 <= Lmin && Lmin <= Lmax && 2 * Lmax - 2 < N);
     int newest = 0;
-    for (int k = 1; k < N; ++k)
-        if (t[k] > t[newest]) newest = k;
+    std::int64_t top = t[0];
+    for (int k = 1; k < N; ++k) {
+        const bool newer = t[k] > top;
+        newest = newer ? k : newest;
+        top = newer ? t[k] : top;
+    }
+    // Centre the work on a copy of the newest pixel whose +-(Lmax-1) neighbourhood
+    // and opposite side all lie inside [0, 2N).
+    const int c = newest < Lmax ? newest + N : newest;
 
-    // Indices lo..hi (inclusive) of the arc, taken modulo N; start in the middle of
-    // [0, 3N) so neither end needs a wrap check.
-    int lo = newest + N;
-    int hi = newest + N;
-    auto at = [t](int i) { return t[i >= 2 * N ? i - 2 * N : (i >= N ? i - N : i)]; };
-    std::int64_t oldest = t[newest];
+    // Cheap rejection, exact: a firing arc holds the newest pixel and at least Lmin
+    // pixels, so its oldest is at most `bound`, the best oldest of the Lmin-windows
+    // through c; and it spans at most Lmax pixels, so the pixels Lmax or more steps
+    // from c lie outside it and must all be older than its oldest.
+    std::int64_t bound = INT64_MIN;
+    for (int s = 0; s < Lmin; ++s) {
+        std::int64_t w = t[c - s];
+        for (int k = 1; k < Lmin; ++k) w = t[c - s + k] < w ? t[c - s + k] : w;
+        bound = w > bound ? w : bound;
+    }
+    for (int k = c + Lmax; k <= c + N - Lmax; ++k)
+        if (t[k] >= bound) return false;
+
+    // Grow the arc [lo, hi] from c, taking the newer neighbour each time.
+    int lo = c;
+    int hi = c;
+    std::int64_t oldest = top;
     int at_least_oldest = -1;  // #pixels with t >= oldest; -1 = stale
     for (int len = 2; len <= Lmax; ++len) {
-        const std::int64_t left = at(lo - 1);
-        const std::int64_t right = at(hi + 1);
-        std::int64_t taken;
-        if (left > right) {
-            taken = left;
-            --lo;
-        } else {
-            taken = right;
-            ++hi;
-        }
+        const std::int64_t left = t[lo - 1];
+        const std::int64_t right = t[hi + 1];
+        const bool go_left = left > right;
+        const std::int64_t taken = go_left ? left : right;
+        lo -= go_left;
+        hi += !go_left;
         if (taken < oldest) {
             oldest = taken;
             at_least_oldest = -1;
         }
         if (len < Lmin) continue;
         if (at_least_oldest < 0) {
-            at_least_oldest = 0;
-            for (int k = 0; k < N; ++k) at_least_oldest += t[k] >= oldest;
+            at_least_oldest = detail::count_at_least<N>(t, oldest);
             // The count only grows as the arc grows; past Lmax nothing can fire.
             if (at_least_oldest > Lmax) return false;
         }
         if (at_least_oldest == len) return true;
     }
     return false;
+}
+
+/// The same test on N values, doubling them first.
+template <int N, int Lmin, int Lmax>
+[[nodiscard]] inline bool arc_fires(const std::array<std::int64_t, N>& t) noexcept {
+    std::array<std::int64_t, 2 * N> twice;
+    for (int k = 0; k < N; ++k) twice[k] = twice[k + N] = t[k];
+    return arc_fires<N, Lmin, Lmax>(twice.data());
 }
 
 template <int N, int Lmin, int Lmax>
