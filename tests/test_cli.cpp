@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "evcorner/io/open.hpp"
 #include "evcorner/io/text_reader.hpp"
 #include "test_util.hpp"
 
@@ -158,6 +159,81 @@ TEST_F(Cli, MissingFileAndUsageErrors) {
 
     r = run("");
     EXPECT_EQ(r.status, 2);
+}
+
+std::vector<std::uint64_t> marked_positions(const fs::path& mask) {
+    std::ifstream in(mask);
+    std::vector<std::uint64_t> marked;
+    std::string line;
+    for (std::uint64_t i = 0; std::getline(in, line); ++i)
+        if (line == "1") marked.push_back(i);
+    return marked;
+}
+
+TEST_F(Cli, HarrisMatchesItsGoldenAndWritesScores) {
+    Result r = run("detect '" + sample_.string() + "' -d harris -q --mask mask.txt -o corners.txt --with-score");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto golden = test::read_index_file(test::bundled_data() / "ecd/shapes_translation/harris.golden.idx");
+    EXPECT_EQ(marked_positions(dir_ / "mask.txt"), golden);
+    std::ifstream in(dir_ / "corners.txt");
+    std::size_t lines = 0;
+    for (std::string line; std::getline(in, line); ++lines) {
+        std::istringstream fields(line);
+        double t, x, y, p, score;
+        ASSERT_TRUE(fields >> t >> x >> y >> p >> score) << line;
+        EXPECT_GT(score, 8.0) << line;  // a corner scores above the threshold
+    }
+    EXPECT_EQ(lines, golden.size());
+
+    r = run("detect '" + sample_.string() + "' -d harris-global --harris-n 2000 -q");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_GT(count_lines(r.out), 0u);
+}
+
+TEST_F(Cli, ParametersOutOfRangeAreRejected) {
+    Result r = run("detect '" + sample_.string() + "' --with-score");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("no score"), std::string::npos) << r.err;
+
+    r = run("detect '" + sample_.string() + "' -d harris --harris-window 3");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--harris-window"), std::string::npos) << r.err;
+
+    r = run("detect '" + sample_.string() + "' -d harris --harris-nl 100");  // 9x9 = 81 pixels
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("nl"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("81"), std::string::npos) << r.err;
+
+    r = run("detect '" + sample_.string() + "' -d harris-global --harris-n 0");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--harris-n"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, CornersInOtherFormatsReadBackToTheSameEvents) {
+    const Result text = run("detect '" + sample_.string() + "' -q -o corners.txt");
+    ASSERT_EQ(text.status, 0) << text.err;
+    const auto expected = io::read_text_file((dir_ / "corners.txt").string());
+    for (const std::string out : {"corners.npy", "corners.csv"}) {
+        const Result r = run("detect '" + sample_.string() + "' -q -o " + out);
+        ASSERT_EQ(r.status, 0) << r.err;
+        auto reader = io::open_event_reader((dir_ / out).string());
+        std::vector<Event> got, buf(4096);
+        while (const std::size_t n = reader->read(buf)) got.insert(got.end(), buf.begin(), buf.begin() + n);
+        EXPECT_EQ(got, expected) << out;
+    }
+}
+
+TEST_F(Cli, Aedat2RecordingsMatchTheirGoldens) {
+    EVCORNER_REQUIRE_SHARED_DATA();
+    for (const char* name : {"IMU_rotDisk", "IMU_translBoxes"}) {
+        const fs::path in = test::shared_data() / "real/davis240c-imu-pyaedattools" / (std::string(name) + ".aedat");
+        const Result r = run("detect '" + in.string() + "' -q -o /dev/null --mask mask.txt");
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(marked_positions(dir_ / "mask.txt"),
+                  test::read_index_file(test::shared_data() / "golden" /
+                                        ("davis240c-imu-pyaedattools." + std::string(name) + ".efast.idx")))
+            << name;
+    }
 }
 
 TEST_F(Cli, HelpHasAnExample) {

@@ -126,14 +126,21 @@ TEST_F(TextIo, EachKindOfError) {
     }
 }
 
+io::ReaderOptions davis240(bool skip_invalid) {
+    io::ReaderOptions o;
+    o.sensor = kDavis240;
+    o.skip_invalid = skip_invalid;
+    return o;
+}
+
 TEST_F(TextIo, OutsideTheSensorIsAnErrorUnlessSkipped) {
     const std::string content = "0.1 1 2 1\n0.2 240 5 1\n0.3 3 4 0\n0.4 5 180 1\n0.5 6 7 1\n";
-    const std::string msg = error_of(content, {.sensor = kDavis240});
+    const std::string msg = error_of(content, davis240(false));
     EXPECT_NE(msg.find(":2:"), std::string::npos) << msg;
     EXPECT_NE(msg.find("x=240 y=5"), std::string::npos) << msg;
     EXPECT_NE(msg.find("240x180"), std::string::npos) << msg;
 
-    io::TextReader r(write_file(content), {.sensor = kDavis240, .skip_invalid = true});
+    io::TextReader r(write_file(content), davis240(true));
     std::vector<Event> out(16);
     ASSERT_EQ(r.read(out), 3u);
     EXPECT_EQ(out[0].t, 100'000);

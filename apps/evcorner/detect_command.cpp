@@ -16,6 +16,7 @@
 #include "evcorner/any_detector.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/error.hpp"
+#include "evcorner/io/event_writer.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/text_writer.hpp"
@@ -33,6 +34,10 @@ struct DetectOptions {
     std::string input;
     std::string detector = "efast";
     std::string output = "-";
+    std::string format = "auto";
+    std::string to = "auto";
+    std::string csv_columns;
+    std::string time_unit = "us";
     std::string size;
     std::string mask;
     std::string summary_json;
@@ -112,7 +117,9 @@ void run_detect(const DetectOptions& o) {
     io::ReaderOptions ropts;
     ropts.skip_invalid = o.skip_invalid;
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);  // validated by CLI11
-    const std::unique_ptr<io::EventReader> source = io::open_event_reader(o.input, ropts);
+    ropts.csv_columns = o.csv_columns;
+    ropts.csv_time_unit = o.time_unit;
+    const std::unique_ptr<io::EventReader> source = io::open_event_reader(o.input, ropts, o.format);
     io::EventReader& reader = *source;
     const SensorSize size = reader.sensor().value_or(kDavis240);
 
@@ -120,7 +127,21 @@ void run_detect(const DetectOptions& o) {
     if (o.with_score && !has_score(detector))
         throw std::invalid_argument("--with-score: detector '" + o.detector +
                                     "' has no score (harris and harris-global have one)");
-    io::TextWriter corners_out(o.output);
+    std::string to = o.to;
+    if (to == "auto") {
+        to = io::output_format_for(o.output);
+        if (to.empty()) to = "ecd-text";
+    }
+    // Scores only fit the text lines ("t x y p score"); every other format takes events.
+    std::unique_ptr<io::TextWriter> scored_out;
+    std::unique_ptr<io::EventWriter> corners_out;
+    if (o.with_score) {
+        if (to != "ecd-text" && to != "text")
+            throw std::invalid_argument("--with-score writes 't x y p score' text lines; it cannot write " + to);
+        scored_out = std::make_unique<io::TextWriter>(o.output);
+    } else {
+        corners_out = io::open_event_writer(o.output, to);
+    }
     std::unique_ptr<io::OutputFile> mask_out;
     if (!o.mask.empty()) mask_out = std::make_unique<io::OutputFile>(o.mask);
 
@@ -128,12 +149,15 @@ void run_detect(const DetectOptions& o) {
     std::vector<Event> events(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
     std::vector<double> scores(o.with_score ? kBatch : 0);
+    std::vector<Event> corners;
+    corners.reserve(kBatch);
     Totals totals;
 
     // Every batch read is detected and written before the next read, so an input
     // error thrown by read() leaves complete, valid outputs for the events before it.
     auto finish_outputs = [&] {
-        corners_out.close();
+        if (scored_out) scored_out->close();
+        if (corners_out) corners_out->close();
         if (mask_out) mask_out->close();
     };
     try {
@@ -156,13 +180,15 @@ void run_detect(const DetectOptions& o) {
                     totals.detect_s += std::chrono::duration<double>(Clock::now() - t0).count();
                     totals.events += n;
                     totals.corners += c;
-                    for (std::size_t i = 0; i < n; ++i)
-                        if (flags[i]) {
-                            if (o.with_score)
-                                corners_out.write(events[i], scores[i]);
-                            else
-                                corners_out.write(events[i]);
-                        }
+                    if (scored_out) {
+                        for (std::size_t i = 0; i < n; ++i)
+                            if (flags[i]) scored_out->write(events[i], scores[i]);
+                    } else {
+                        corners.clear();
+                        for (std::size_t i = 0; i < n; ++i)
+                            if (flags[i]) corners.push_back(events[i]);
+                        corners_out->write(corners);
+                    }
                     if (mask_out) write_mask(*mask_out, flags, n, skips);
                     progress.update(reader.bytes_consumed(), totals.events);
                 }
@@ -197,10 +223,11 @@ void add_detect_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "detect",
         "Detect corner events in an event stream and write them out.\n"
-        "Input: Event-Camera-Dataset text, one event per line 't x y p' (t in seconds,\n"
-        "p = 1 for ON, 0 for OFF); '-' reads standard input. Output: the corner events in\n"
-        "the same format. A summary (events, corners, reduction rate, detection time per\n"
-        "event, wall time) goes to standard error.");
+        "Input: any format evcorner reads, told by the content (or --format): Event-Camera-\n"
+        "Dataset text ('t x y p' per line, t in seconds, p = 1 ON / 0 OFF), CSV, .npy, AEDAT 2,\n"
+        "Prophesee EVT 2/EVT 3/DAT; '-' reads standard input. Output: the corner events, as\n"
+        "text unless OUTPUT's extension or --to names another format. A summary (events,\n"
+        "corners, reduction rate, detection time per event, wall time) goes to standard error.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     cmd->add_option("-d,--detector", o->detector, "Detector to run:" + detectors)
         ->capture_default_str()
@@ -209,11 +236,17 @@ void add_detect_command(CLI::App& app) {
                 if (d.name == name) return std::string();
             return "unknown detector '" + name + "'";
         });
-    cmd->add_option("-o,--output", o->output, "Corner events, as 't x y p' lines (- = standard output)")
+    cmd->add_option("-o,--output", o->output,
+                    "Corner events (- = standard output, as 't x y p' lines); the format follows the "
+                    "extension (.txt, .csv, .npy)")
         ->capture_default_str();
+    cmd->add_option("--to", o->to, "Output format: auto (by extension, else ecd-text), " +
+                                       std::string(io::kOutputFormats))
+        ->capture_default_str();
+    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
     cmd->add_option("--size", o->size,
-                    "Sensor size WxH; events outside it are errors [default: 240x180, the "
-                    "DAVIS240C of the Event-Camera Dataset]")
+                    "Sensor size WxH; events outside it are errors [default: the file's own "
+                    "size, else 240x180, the DAVIS240C of the Event-Camera Dataset]")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string()
                                         : "expected WxH with sides 1..65536, e.g. 346x260";
@@ -246,6 +279,7 @@ void add_detect_command(CLI::App& app) {
     cmd->footer(
         "Examples:\n"
         "  evcorner detect events.txt -o corners.txt\n"
+        "  evcorner detect recording.raw -o corners.npy      # Prophesee EVT 3 in, numpy out\n"
         "  evcorner detect events.txt --mask is_corner.txt --summary-json summary.json > corners.txt\n"
         "  evcorner detect events.txt -d harris --with-score | head\n"
         "  evcorner detect events.txt -d harris-global --harris-n 2000\n"

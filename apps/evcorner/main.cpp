@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
 
 #include "commands.hpp"
 
@@ -33,6 +34,10 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         app.exit(e);
+        return 2;
+    } catch (const std::invalid_argument& e) {
+        // A parameter out of range, caught when the detector or writer is built.
+        std::fprintf(stderr, "evcorner: error: %s\n", e.what());
         return 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "evcorner: error: %s\n", e.what());
