@@ -46,7 +46,7 @@ void run_convert(const ConvertOptions& o) {
             throw OutputError(o.output, "cannot tell the output format from the extension; pass --to (" +
                                             std::string(io::kOutputFormats) + ")");
     }
-    const auto writer = io::open_event_writer(o.output, to);
+    const auto writer = io::open_event_writer(o.output, to, reader->sensor());
     std::vector<Event> buf(kBatch);
     std::uint64_t events = 0;
     try {
@@ -77,7 +77,7 @@ void add_convert_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "convert",
         "Convert an event file to another format. The input format is told by the content\n"
-        "(or --format); the output format by OUTPUT's extension (.txt, .csv, .npy) or --to.");
+        "(or --format); the output format by OUTPUT's extension (.txt, .csv, .npy, .aedat4) or --to.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     cmd->add_option("OUTPUT", o->output, "Output file (- = standard output, text formats)")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);

@@ -1,6 +1,7 @@
 #include "evcorner/io/event_writer.hpp"
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/aedat4_writer.hpp"
 #include "evcorner/io/csv_writer.hpp"
 #include "evcorner/io/npy.hpp"
 #include "evcorner/io/text_writer.hpp"
@@ -35,10 +36,12 @@ std::string output_format_for(const std::string& path) {
     if (ends_with(path, ".txt")) return "ecd-text";
     if (ends_with(path, ".csv")) return "csv";
     if (ends_with(path, ".npy")) return "npy";
+    if (ends_with(path, ".aedat4")) return "aedat4";
     return "";
 }
 
-std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format) {
+std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format,
+                                               std::optional<SensorSize> sensor) {
     std::string f(format);
     if (f == "auto") {
         f = output_format_for(path);
@@ -47,6 +50,11 @@ std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::str
     if (f == "ecd-text" || f == "text") return std::make_unique<TextEventWriter>(path);
     if (f == "csv") return std::make_unique<CsvWriter>(path);
     if (f == "npy") return std::make_unique<NpyWriter>(path);
+    if (f == "aedat4") {
+        Aedat4Writer::Options o;
+        o.sensor = sensor;
+        return std::make_unique<Aedat4Writer>(path, o);
+    }
     throw OutputError(path == "-" ? "<stdout>" : path,
                       "unknown output format '" + f + "' (known: " + std::string(kOutputFormats) + ")");
 }

@@ -4,11 +4,13 @@
 // reader to the identical events.
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 
 #include "evcorner/event.hpp"
+#include "evcorner/sensor.hpp"
 
 namespace evcorner::io {
 
@@ -23,14 +25,16 @@ public:
 };
 
 /// The format names open_event_writer() accepts, besides "auto".
-inline constexpr std::string_view kOutputFormats = "ecd-text, csv, npy";
+inline constexpr std::string_view kOutputFormats = "ecd-text, csv, npy, aedat4";
 
 /// The output format for `path` by its extension: .txt -> ecd-text, .csv -> csv,
-/// .npy -> npy; "" when the extension says nothing.
+/// .npy -> npy, .aedat4 -> aedat4; "" when the extension says nothing.
 std::string output_format_for(const std::string& path);
 
 /// Creates `path` ("-" = standard output, text formats only) in `format` ("auto": by
-/// extension, ecd-text when it says nothing). Throws OutputError.
-std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format = "auto");
+/// extension, ecd-text when it says nothing). `sensor`: the sensor size for formats that
+/// record one (AEDAT 4.0; nullopt: the smallest holding every event). Throws OutputError.
+std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format = "auto",
+                                               std::optional<SensorSize> sensor = std::nullopt);
 
 }  // namespace evcorner::io
