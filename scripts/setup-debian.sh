@@ -8,6 +8,8 @@ packages=(
   libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   zlib1g-dev
+  liblz4-dev libzstd-dev libhdf5-dev hdf5-filter-plugin
+  clang libclang-rt-14-dev
 )
 
 missing=()
