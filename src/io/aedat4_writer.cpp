@@ -105,7 +105,7 @@ void make_packet_head(unsigned char* p, std::size_t n) {
 }
 
 std::string regular_or_sized(std::string path, const Aedat4Writer::Options& o) {
-    if (path == "-" && !o.sensor)
+    if (path.size() == 1 && path[0] == '-' && !o.sensor)
         throw OutputError("<stdout>", "an AEDAT 4.0 file without a given sensor size cannot go to standard "
                                       "output (the size is written into its header at the end)");
     return path;

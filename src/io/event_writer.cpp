@@ -2,6 +2,7 @@
 
 #include "evcorner/error.hpp"
 #include "evcorner/io/aedat4_writer.hpp"
+#include "evcorner/io/hdf5_events.hpp"
 #include "evcorner/io/csv_writer.hpp"
 #include "evcorner/io/npy.hpp"
 #include "evcorner/io/text_writer.hpp"
@@ -37,6 +38,7 @@ std::string output_format_for(const std::string& path) {
     if (ends_with(path, ".csv")) return "csv";
     if (ends_with(path, ".npy")) return "npy";
     if (ends_with(path, ".aedat4")) return "aedat4";
+    if (ends_with(path, ".h5") || ends_with(path, ".hdf5")) return "hdf5";
     return "";
 }
 
@@ -54,6 +56,11 @@ std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::str
         Aedat4Writer::Options o;
         o.sensor = sensor;
         return std::make_unique<Aedat4Writer>(path, o);
+    }
+    if (f == "hdf5" || f == "h5") {
+        Hdf5Writer::Options o;
+        o.sensor = sensor;
+        return std::make_unique<Hdf5Writer>(path, o);
     }
     throw OutputError(path == "-" ? "<stdout>" : path,
                       "unknown output format '" + f + "' (known: " + std::string(kOutputFormats) + ")");

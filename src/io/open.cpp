@@ -13,6 +13,7 @@
 #include "evcorner/io/dat_reader.hpp"
 #include "evcorner/io/evt2_reader.hpp"
 #include "evcorner/io/evt3_reader.hpp"
+#include "evcorner/io/hdf5_events.hpp"
 #include "evcorner/io/npy.hpp"
 #include "evcorner/io/prophesee_header.hpp"
 #include "evcorner/io/text_reader.hpp"
@@ -46,6 +47,7 @@ std::string detect_format(const std::string& path) {
     const std::string head = head_of(path, 1 << 16);
     if (starts_with(head, "#!AER-DAT2.0")) return "aedat2";
     if (starts_with(head, kAedat4Magic)) return "aedat4";
+    if (starts_with(head, kHdf5Magic)) return "hdf5";
     if (starts_with(head, "\x93NUMPY")) return "npy";
     if (starts_with(head, "%")) {
         // Prophesee: the '%' header names the encoding (RAW) or says "Data file" (DAT).
@@ -88,6 +90,7 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
     }
     if (fmt_name == "aedat2" || fmt_name == "aedat") return std::make_unique<Aedat2Reader>(path, options);
     if (fmt_name == "aedat4") return std::make_unique<Aedat4Reader>(path, options);
+    if (fmt_name == "hdf5" || fmt_name == "h5") return std::make_unique<Hdf5Reader>(path, options);
     if (fmt_name == "csv") return std::make_unique<CsvReader>(path, options);
     if (fmt_name == "evt3") return std::make_unique<Evt3Reader>(path, options);
     if (fmt_name == "evt2") return std::make_unique<Evt2Reader>(path, options);

@@ -25,15 +25,15 @@ public:
 };
 
 /// The format names open_event_writer() accepts, besides "auto".
-inline constexpr std::string_view kOutputFormats = "ecd-text, csv, npy, aedat4";
+inline constexpr std::string_view kOutputFormats = "ecd-text, csv, npy, aedat4, hdf5";
 
 /// The output format for `path` by its extension: .txt -> ecd-text, .csv -> csv,
-/// .npy -> npy, .aedat4 -> aedat4; "" when the extension says nothing.
+/// .npy -> npy, .aedat4 -> aedat4, .h5 / .hdf5 -> hdf5 (DSEC layout); "" when the extension says nothing.
 std::string output_format_for(const std::string& path);
 
 /// Creates `path` ("-" = standard output, text formats only) in `format` ("auto": by
 /// extension, ecd-text when it says nothing). `sensor`: the sensor size for formats that
-/// record one (AEDAT 4.0; nullopt: the smallest holding every event). Throws OutputError.
+/// record one (AEDAT 4.0, HDF5; nullopt: the smallest holding every event). Throws OutputError.
 std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format = "auto",
                                                std::optional<SensorSize> sensor = std::nullopt);
 

@@ -11,10 +11,10 @@
 namespace evcorner::io {
 
 /// The format names open_event_reader() accepts, besides "auto".
-inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat";
+inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat, hdf5";
 
 /// Tells the format of `path` from its first bytes: "aedat2" ("#!AER-DAT2.0"), "aedat4"
-/// ("#!AER-DAT4.0\r\n"), "npy",
+/// ("#!AER-DAT4.0\r\n"), "hdf5" (the HDF5 signature at byte 0), "npy",
 /// "evt2" / "evt3" (a Prophesee '%' header with "% evt 2.0|3.0" or "% format EVT2|EVT3"),
 /// "dat" ("% Data file containing ..."), "csv" (the first non-comment line has a
 /// comma), else "ecd-text". Throws InputError for a

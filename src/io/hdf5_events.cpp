@@ -1,0 +1,438 @@
+#include "evcorner/io/hdf5_events.hpp"
+
+#include <hdf5.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fmt/format.h>
+#include <utility>
+
+#include "evcorner/error.hpp"
+
+namespace evcorner::io {
+
+namespace {
+
+// An HDF5 identifier closed by the matching H5?close at scope exit.
+class Hid {
+public:
+    Hid() = default;
+    Hid(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+    Hid(Hid&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = H5I_INVALID_HID; }
+    Hid& operator=(Hid&& o) noexcept {
+        std::swap(id_, o.id_);
+        std::swap(close_, o.close_);
+        return *this;
+    }
+    ~Hid() {
+        if (id_ >= 0 && close_) {
+            H5E_BEGIN_TRY { close_(id_); }
+            H5E_END_TRY;
+        }
+    }
+    [[nodiscard]] hid_t get() const noexcept { return id_; }
+    hid_t release() noexcept { return std::exchange(id_, H5I_INVALID_HID); }
+    [[nodiscard]] bool ok() const noexcept { return id_ >= 0; }
+
+private:
+    hid_t id_ = H5I_INVALID_HID;
+    herr_t (*close_)(hid_t) = nullptr;
+};
+
+// HDF5 prints its error stack on failure unless told not to; the callers report errors.
+template <class F>
+auto quiet(F&& f) {
+    decltype(f()) r{};
+    H5E_BEGIN_TRY { r = f(); }
+    H5E_END_TRY;
+    return r;
+}
+
+bool link_exists(hid_t loc, const char* name) { return quiet([&] { return H5Lexists(loc, name, H5P_DEFAULT); }) > 0; }
+
+// The Debian package that holds an HDF5 filter plugin.
+std::string filter_hint(H5Z_filter_t id) {
+    switch (id) {
+        case 32001: return "the Blosc filter (Debian: apt-get install hdf5-filter-plugin-blosc-serial)";
+        case 32004: return "the LZ4 filter (Debian: apt-get install hdf5-filter-plugin)";
+        case 307: return "the BZip2 filter (Debian: apt-get install hdf5-filter-plugin)";
+        case 32008: return "the Bitshuffle filter (Debian: apt-get install hdf5-filter-plugin)";
+        case 32015: return "the ZSTD filter (not packaged in Debian 12: install hdf5plugin's libh5zstd into HDF5_PLUGIN_PATH)";
+        default: return fmt::format("HDF5 filter {} (see https://portal.hdfgroup.org/display/support/Registered+Filter+Plugins)", id);
+    }
+}
+
+std::optional<std::uint64_t> regular_file_size(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+    return static_cast<std::uint64_t>(st.st_size);
+}
+
+}  // namespace
+
+struct Hdf5Reader::Impl {
+    Hid file;
+    Hid dset[4];  // x, y, t, p
+    const char* names[4] = {};
+    bool t_float = false;
+    bool p_enum = false;
+    std::size_t p_size = 1;
+    hsize_t chunk = 0;  // the datasets' chunk length (0: contiguous)
+    std::vector<unsigned char> p_raw;
+};
+
+Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
+    : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdin>" : path), options_(std::move(options)) {
+    if (path == "-") throw InputError(name_, "HDF5 files cannot be read from standard input");
+    file_size_ = regular_file_size(path);
+    if (!file_size_) throw InputError(name_, "cannot open: not a regular file, or missing");
+    if (quiet([&] { return H5Fis_hdf5(path.c_str()); }) <= 0)
+        throw InputError(name_, InputError::Unit::byte, 0, "not an HDF5 file (no HDF5 signature)");
+    impl_->file = Hid(quiet([&] { return H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT); }), H5Fclose);
+    if (!impl_->file.ok()) throw InputError(name_, "HDF5 cannot open the file (damaged?)");
+    const hid_t f = impl_->file.get();
+    if (!link_exists(f, "events")) throw InputError(name_, "no 'events' group: not a DSEC or event_utils HDF5 file");
+    static const char* dsec[4] = {"events/x", "events/y", "events/t", "events/p"};
+    static const char* eu[4] = {"events/xs", "events/ys", "events/ts", "events/ps"};
+    if (link_exists(f, dsec[2]))
+        layout_ = Layout::dsec;
+    else if (link_exists(f, eu[2]))
+        layout_ = Layout::event_utils;
+    else
+        throw InputError(name_, "neither events/t (DSEC) nor events/ts (event_utils) exists");
+    const char* const* names = layout_ == Layout::dsec ? dsec : eu;
+    for (int i = 0; i < 4; ++i) {
+        impl_->names[i] = names[i];
+        impl_->dset[i] = Hid(quiet([&] { return H5Dopen2(f, names[i], H5P_DEFAULT); }), H5Dclose);
+        if (!impl_->dset[i].ok()) throw InputError(name_, fmt::format("cannot open dataset {}", names[i]));
+        const hid_t d = impl_->dset[i].get();
+        Hid space(H5Dget_space(d), H5Sclose);
+        hsize_t dims[2] = {0, 0};
+        if (!space.ok() || quiet([&] { return H5Sget_simple_extent_ndims(space.get()); }) != 1 ||
+            quiet([&] { return H5Sget_simple_extent_dims(space.get(), dims, nullptr); }) != 1)
+            throw InputError(name_, fmt::format("dataset {} is not one-dimensional", names[i]));
+        if (i == 0)
+            total_ = dims[0];
+        else if (dims[0] != total_)
+            throw InputError(name_, fmt::format("dataset {} holds {} values but {} holds {}", names[i], dims[0],
+                                                names[0], total_));
+        Hid type(H5Dget_type(d), H5Tclose);
+        const H5T_class_t cls = type.ok() ? H5Tget_class(type.get()) : H5T_NO_CLASS;
+        const bool number = cls == H5T_INTEGER || cls == H5T_FLOAT || (i == 3 && cls == H5T_ENUM);
+        if (!number) throw InputError(name_, fmt::format("dataset {} does not hold numbers", names[i]));
+        if (i == 2) impl_->t_float = cls == H5T_FLOAT;
+        if (i == 3 && cls == H5T_ENUM) {
+            impl_->p_enum = true;
+            impl_->p_size = H5Tget_size(type.get());
+            if (impl_->p_size != 1 && impl_->p_size != 2 && impl_->p_size != 4)
+                throw InputError(name_, fmt::format("dataset {}: unsupported enum size {}", names[i], impl_->p_size));
+        }
+        // A filter HDF5 cannot load (a missing plugin) fails every read: say so now.
+        Hid dcpl(H5Dget_create_plist(d), H5Pclose);
+        const int nf = dcpl.ok() ? H5Pget_nfilters(dcpl.get()) : 0;
+        for (int k = 0; k < nf; ++k) {
+            unsigned flags = 0;
+            std::size_t nelem = 0;
+            char fname[64] = {};
+            const H5Z_filter_t id =
+                quiet([&] { return H5Pget_filter2(dcpl.get(), static_cast<unsigned>(k), &flags, &nelem, nullptr,
+                                                  sizeof fname, fname, nullptr); });
+            if (id >= 0 && quiet([&] { return H5Zfilter_avail(id); }) <= 0)
+                throw InputError(name_, fmt::format("dataset {} is compressed with {}, which HDF5 cannot load: "
+                                                    "install {}",
+                                                    names[i], id, filter_hint(id)));
+        }
+        if (i == 0 && dcpl.ok() && H5Pget_layout(dcpl.get()) == H5D_CHUNKED) {
+            hsize_t c = 0;
+            if (H5Pget_chunk(dcpl.get(), 1, &c) == 1) impl_->chunk = c;
+        }
+    }
+    // t_offset (DSEC): a scalar integer dataset at the root.
+    if (layout_ == Layout::dsec && link_exists(f, "t_offset")) {
+        Hid d(quiet([&] { return H5Dopen2(f, "t_offset", H5P_DEFAULT); }), H5Dclose);
+        Hid space(d.ok() ? H5Dget_space(d.get()) : H5I_INVALID_HID, H5Sclose);
+        if (!space.ok() || quiet([&] { return H5Sget_simple_extent_npoints(space.get()); }) != 1 ||
+            quiet([&] { return H5Dread(d.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, &t_offset_); }) < 0)
+            throw InputError(name_, "t_offset is not a single integer");
+    }
+    // Sensor size: width / height, else sensor_resolution = (height, width).
+    std::optional<SensorSize> from_file;
+    const auto read_attr = [&](const char* name, int* values, hssize_t want_min, hssize_t want_max) -> hssize_t {
+        if (quiet([&] { return H5Aexists(f, name); }) <= 0) return 0;
+        Hid a(quiet([&] { return H5Aopen(f, name, H5P_DEFAULT); }), H5Aclose);
+        Hid space(a.ok() ? H5Aget_space(a.get()) : H5I_INVALID_HID, H5Sclose);
+        Hid type(a.ok() ? H5Aget_type(a.get()) : H5I_INVALID_HID, H5Tclose);
+        if (!space.ok() || !type.ok() || H5Tget_class(type.get()) != H5T_INTEGER) return 0;
+        const hssize_t n = quiet([&] { return H5Sget_simple_extent_npoints(space.get()); });
+        if (n < want_min || n > want_max) return 0;
+        if (quiet([&] { return H5Aread(a.get(), H5T_NATIVE_INT, values); }) < 0) return 0;
+        return n;
+    };
+    int w = 0, h = 0, res[3] = {0, 0, 0};
+    if (read_attr("width", &w, 1, 1) && read_attr("height", &h, 1, 1))
+        from_file = SensorSize{w, h};
+    else if (read_attr("sensor_resolution", res, 2, 3))
+        from_file = SensorSize{res[1], res[0]};
+    if (from_file && (from_file->width < 1 || from_file->height < 1 || from_file->width > kMaxSensorSide ||
+                      from_file->height > kMaxSensorSide))
+        throw InputError(name_, fmt::format("sensor size {}x{} in the file's attributes is out of range",
+                                            from_file->width, from_file->height));
+    sensor_ = options_.sensor ? options_.sensor : from_file ? from_file : options_.fallback_sensor;
+    limit_w_ = static_cast<std::uint32_t>(sensor_ ? sensor_->width : kMaxSensorSide);
+    limit_h_ = static_cast<std::uint32_t>(sensor_ ? sensor_->height : kMaxSensorSide);
+}
+
+Hdf5Reader::~Hdf5Reader() = default;
+
+std::uint64_t Hdf5Reader::bytes_consumed() const noexcept {
+    if (!file_size_ || total_ == 0) return 0;
+    const double done = static_cast<double>(chunk_start_ + next_) / static_cast<double>(total_);
+    return static_cast<std::uint64_t>(done * static_cast<double>(*file_size_));
+}
+
+void Hdf5Reader::fail_at(std::uint64_t index, int dataset, const std::string& reason) const {
+    // The file address of the data holding event `index` of the dataset, where HDF5 knows it.
+    const hid_t d = impl_->dset[dataset].get();
+    haddr_t addr = HADDR_UNDEF;
+    if (impl_->chunk > 0) {
+        const hsize_t start = index / impl_->chunk * impl_->chunk;
+        unsigned mask = 0;
+        hsize_t size = 0;
+        if (quiet([&] { return H5Dget_chunk_info_by_coord(d, &start, &mask, &addr, &size); }) < 0) addr = HADDR_UNDEF;
+    } else {
+        addr = quiet([&] { return H5Dget_offset(d); });
+        if (addr != HADDR_UNDEF) {
+            Hid type(H5Dget_type(d), H5Tclose);
+            addr += index * (type.ok() ? H5Tget_size(type.get()) : 0);
+        }
+    }
+    const std::string what = fmt::format("event {} ({}): {}", index, impl_->names[dataset], reason);
+    if (addr == HADDR_UNDEF) throw InputError(name_, what);
+    throw InputError(name_, InputError::Unit::byte, addr, what);
+}
+
+void Hdf5Reader::load_chunk() {
+    chunk_start_ += chunk_n_;
+    next_ = 0;
+    chunk_n_ = static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, total_ - chunk_start_));
+    if (chunk_n_ == 0) return;
+    x_.resize(kChunk);
+    y_.resize(kChunk);
+    p_.resize(kChunk);
+    if (impl_->t_float) ts_.resize(kChunk);
+    t_.resize(kChunk);
+    const hsize_t start = chunk_start_, count = chunk_n_;
+    Hid mem(H5Screate_simple(1, &count, nullptr), H5Sclose);
+    for (int i = 0; i < 4; ++i) {
+        const hid_t d = impl_->dset[i].get();
+        Hid space(H5Dget_space(d), H5Sclose);
+        if (!space.ok() || quiet([&] { return H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &start, nullptr,
+                                                                  &count, nullptr); }) < 0)
+            fail_at(chunk_start_, i, "cannot select the events to read");
+        herr_t r = -1;
+        if (i == 0) r = quiet([&] { return H5Dread(d, H5T_NATIVE_INT32, mem.get(), space.get(), H5P_DEFAULT, x_.data()); });
+        if (i == 1) r = quiet([&] { return H5Dread(d, H5T_NATIVE_INT32, mem.get(), space.get(), H5P_DEFAULT, y_.data()); });
+        if (i == 2)
+            r = impl_->t_float
+                    ? quiet([&] { return H5Dread(d, H5T_NATIVE_DOUBLE, mem.get(), space.get(), H5P_DEFAULT, ts_.data()); })
+                    : quiet([&] { return H5Dread(d, H5T_NATIVE_INT64, mem.get(), space.get(), H5P_DEFAULT, t_.data()); });
+        if (i == 3) {
+            if (impl_->p_enum) {
+                impl_->p_raw.resize(kChunk * impl_->p_size);
+                Hid ft(H5Dget_type(d), H5Tclose);
+                Hid mt(ft.ok() ? H5Tget_native_type(ft.get(), H5T_DIR_ASCEND) : H5I_INVALID_HID, H5Tclose);
+                if (mt.ok() && H5Tget_size(mt.get()) == impl_->p_size)
+                    r = quiet([&] { return H5Dread(d, mt.get(), mem.get(), space.get(), H5P_DEFAULT, impl_->p_raw.data()); });
+                for (std::size_t k = 0; r >= 0 && k < chunk_n_; ++k) {
+                    const unsigned char* q = impl_->p_raw.data() + k * impl_->p_size;
+                    if (impl_->p_size == 1) p_[k] = static_cast<std::int8_t>(q[0]);
+                    if (impl_->p_size == 2) { std::int16_t v; std::memcpy(&v, q, 2); p_[k] = v; }
+                    if (impl_->p_size == 4) std::memcpy(&p_[k], q, 4);
+                }
+            } else {
+                r = quiet([&] { return H5Dread(d, H5T_NATIVE_INT32, mem.get(), space.get(), H5P_DEFAULT, p_.data()); });
+            }
+        }
+        if (r < 0) fail_at(chunk_start_, i, "HDF5 cannot read these events (damaged data, or a filter that fails)");
+    }
+    if (impl_->t_float) {
+        for (std::size_t k = 0; k < chunk_n_; ++k) {
+            const double us = ts_[k] * 1e6;
+            if (!std::isfinite(us) || std::fabs(us) > 9.0e18)
+                fail_at(chunk_start_ + k, 2, fmt::format("time {} s is not a finite time", ts_[k]));
+            t_[k] = std::llround(us);
+        }
+    } else if (t_offset_ != 0) {
+        for (std::size_t k = 0; k < chunk_n_; ++k) {
+            if (__builtin_add_overflow(t_[k], t_offset_, &t_[k]))
+                fail_at(chunk_start_ + k, 2, "t + t_offset overflows 64 bits");
+        }
+    }
+}
+
+std::size_t Hdf5Reader::read(std::span<Event> out) {
+    skipped_in_batch_.clear();
+    if (error_) std::rethrow_exception(error_);
+    std::size_t n = 0;
+    try {
+        while (n < out.size() && skipped_in_batch_.size() < out.size()) {
+            if (next_ == chunk_n_) {
+                if (chunk_start_ + chunk_n_ >= total_) break;
+                load_chunk();
+                continue;
+            }
+            const std::size_t k = next_++;
+            const auto x = static_cast<std::uint32_t>(x_[k]);  // negative: huge, outside
+            const auto y = static_cast<std::uint32_t>(y_[k]);
+            if (x >= limit_w_ || y >= limit_h_) [[unlikely]] {
+                if (!options_.skip_invalid) {
+                    if (sensor_)
+                        fail_at(chunk_start_ + k, 0,
+                                fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, or "
+                                            "--skip-invalid to skip such events)",
+                                            x_[k], y_[k], sensor_->width, sensor_->height));
+                    fail_at(chunk_start_ + k, 0, fmt::format("event at x={} y={} does not fit 16-bit coordinates", x_[k], y_[k]));
+                }
+                ++skipped_;
+                if (!skipped_in_batch_.empty() && skipped_in_batch_.back().before == n)
+                    ++skipped_in_batch_.back().count;
+                else
+                    skipped_in_batch_.push_back({n, 1});
+                continue;
+            }
+            if (t_[k] < last_t_) [[unlikely]]
+                fail_at(chunk_start_ + k, 2,
+                        fmt::format("timestamp goes backwards ({} us before the previous event)", last_t_ - t_[k]));
+            last_t_ = t_[k];
+            out[n++] = Event{t_[k], static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
+                             static_cast<std::uint8_t>(p_[k] > 0)};
+        }
+    } catch (const InputError&) {
+        error_ = std::current_exception();
+        if (n == 0 && skipped_in_batch_.empty()) throw;
+    }
+    return n;
+}
+
+// ---------------------------------------------------------------- writer
+
+struct Hdf5Writer::Impl {
+    Hid file, group;
+    Hid dset[4];  // x, y, t, p
+};
+
+bool Hdf5Writer::filter_available(int id) {
+    return quiet([&] { return H5Zfilter_avail(static_cast<H5Z_filter_t>(id)); }) > 0;
+}
+
+Hdf5Writer::Hdf5Writer(std::string path, Options options)
+    : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdout>" : path), options_(options) {
+    if (path == "-") throw OutputError(name_, "HDF5 files cannot go to standard output");
+    if (options_.chunk_events == 0) options_.chunk_events = std::size_t{1} << 16;
+    impl_->file = Hid(quiet([&] { return H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT); }), H5Fclose);
+    if (!impl_->file.ok()) throw OutputError(name_, "HDF5 cannot create the file");
+    impl_->group = Hid(quiet([&] { return H5Gcreate2(impl_->file.get(), "events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT); }),
+                       H5Gclose);
+    if (!impl_->group.ok()) throw OutputError(name_, "HDF5 cannot create the events group");
+    const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = options_.chunk_events;
+    Hid space(H5Screate_simple(1, &zero, &unlimited), H5Sclose);
+    Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+    H5Pset_chunk(dcpl.get(), 1, &chunk);
+    if (options_.filter == 1) {
+        H5Pset_deflate(dcpl.get(), 4);
+    } else if (options_.filter != 0) {
+        if (!filter_available(options_.filter))
+            throw OutputError(name_, fmt::format("HDF5 cannot load {}", filter_hint(static_cast<H5Z_filter_t>(options_.filter))));
+        // Blosc: values 0..3 are filled in by the filter; level 5, byte shuffle, ZSTD (5).
+        const unsigned cd[7] = {0, 0, 0, 0, 5, 1, 5};
+        if (quiet([&] { return H5Pset_filter(dcpl.get(), static_cast<H5Z_filter_t>(options_.filter), H5Z_FLAG_MANDATORY,
+                                              options_.filter == 32001 ? 7 : 0, cd); }) < 0)
+            throw OutputError(name_, fmt::format("HDF5 cannot set filter {}", options_.filter));
+    }
+    const char* names[4] = {"x", "y", "t", "p"};
+    const hid_t types[4] = {H5T_STD_U16LE, H5T_STD_U16LE, H5T_STD_I64LE, H5T_STD_U8LE};
+    for (int i = 0; i < 4; ++i) {
+        impl_->dset[i] = Hid(quiet([&] { return H5Dcreate2(impl_->group.get(), names[i], types[i], space.get(), H5P_DEFAULT,
+                                                           dcpl.get(), H5P_DEFAULT); }),
+                             H5Dclose);
+        if (!impl_->dset[i].ok()) throw OutputError(name_, fmt::format("HDF5 cannot create events/{}", names[i]));
+    }
+    x_.reserve(options_.chunk_events);
+    y_.reserve(options_.chunk_events);
+    p_.reserve(options_.chunk_events);
+    t_.reserve(options_.chunk_events);
+}
+
+Hdf5Writer::~Hdf5Writer() {
+    try {
+        close();
+    } catch (...) {
+    }
+}
+
+void Hdf5Writer::write(std::span<const Event> events) {
+    if (closed_) throw OutputError(name_, "write after close");
+    for (const Event& e : events) {
+        if (!t_offset_) t_offset_ = e.t;
+        x_.push_back(e.x);
+        y_.push_back(e.y);
+        p_.push_back(e.p != 0);
+        t_.push_back(e.t - *t_offset_);
+        if (x_.size() == options_.chunk_events) flush();
+    }
+}
+
+void Hdf5Writer::flush() {
+    if (x_.empty()) return;
+    const hsize_t start = written_, count = x_.size(), size = written_ + x_.size();
+    Hid mem(H5Screate_simple(1, &count, nullptr), H5Sclose);
+    const void* bufs[4] = {x_.data(), y_.data(), t_.data(), p_.data()};
+    const hid_t mtypes[4] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64, H5T_NATIVE_UINT8};
+    for (int i = 0; i < 4; ++i) {
+        const hid_t d = impl_->dset[i].get();
+        if (quiet([&] { return H5Dset_extent(d, &size); }) < 0) throw OutputError(name_, "HDF5 cannot extend a dataset");
+        Hid space(H5Dget_space(d), H5Sclose);
+        if (quiet([&] { return H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr); }) < 0 ||
+            quiet([&] { return H5Dwrite(d, mtypes[i], mem.get(), space.get(), H5P_DEFAULT, bufs[i]); }) < 0)
+            throw OutputError(name_, "HDF5 write failed");
+    }
+    written_ += x_.size();
+    x_.clear();
+    y_.clear();
+    p_.clear();
+    t_.clear();
+}
+
+void Hdf5Writer::close() {
+    if (closed_) return;
+    closed_ = true;
+    flush();
+    const hid_t f = impl_->file.get();
+    {
+        Hid scalar(H5Screate(H5S_SCALAR), H5Sclose);
+        const std::int64_t off = t_offset_.value_or(0);
+        Hid d(quiet([&] { return H5Dcreate2(f, "t_offset", H5T_STD_I64LE, scalar.get(), H5P_DEFAULT, H5P_DEFAULT,
+                                            H5P_DEFAULT); }),
+              H5Dclose);
+        if (!d.ok() || quiet([&] { return H5Dwrite(d.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, &off); }) < 0)
+            throw OutputError(name_, "HDF5 cannot write t_offset");
+        if (options_.sensor) {
+            const int wh[2] = {options_.sensor->width, options_.sensor->height};
+            const char* names[2] = {"width", "height"};
+            for (int i = 0; i < 2; ++i) {
+                Hid a(quiet([&] { return H5Acreate2(f, names[i], H5T_STD_I32LE, scalar.get(), H5P_DEFAULT, H5P_DEFAULT); }),
+                      H5Aclose);
+                if (!a.ok() || quiet([&] { return H5Awrite(a.get(), H5T_NATIVE_INT, &wh[i]); }) < 0)
+                    throw OutputError(name_, "HDF5 cannot write the sensor size");
+            }
+        }
+    }
+    for (auto& ds : impl_->dset) ds = Hid();
+    impl_->group = Hid();
+    const hid_t fid = impl_->file.release();
+    if (quiet([&] { return H5Fclose(fid); }) < 0) throw OutputError(name_, "HDF5 cannot complete the file");
+}
+
+}  // namespace evcorner::io
