@@ -9,6 +9,9 @@ namespace evcorner::cli {
 void add_detect_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
+void add_label_command(CLI::App& app);
+void add_eval_command(CLI::App& app);
+void add_render_command(CLI::App& app);
 
 /// The input-format options that info and convert share (--format, --csv-columns, --time-unit).
 void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit);

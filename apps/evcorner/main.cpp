@@ -20,10 +20,14 @@ int main(int argc, char** argv) {
         "  evcorner detect events.txt -o corners.txt     # Event-Camera-Dataset text in and out\n"
         "  evcorner info recording.aedat                 # what a file holds (AEDAT2, EVT2/3, DAT, CSV, npy)\n"
         "  evcorner convert recording.raw events.npy     # any readable format to text, CSV or npy\n"
+        "  evcorner eval data/ecd --report report        # the paper's Tables 1 and 2, figures\n"
         "Exit status: 0 on success, 1 on bad input or a failed write, 2 on a usage error.");
     evcorner::cli::add_detect_command(app);
     evcorner::cli::add_info_command(app);
     evcorner::cli::add_convert_command(app);
+    evcorner::cli::add_label_command(app);
+    evcorner::cli::add_eval_command(app);
+    evcorner::cli::add_render_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

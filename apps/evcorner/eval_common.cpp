@@ -1,0 +1,99 @@
+#include "eval_common.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "commands.hpp"
+#include "evcorner/detector.hpp"
+#include "evcorner/io/open.hpp"
+
+namespace evcorner::cli {
+
+LoadedEvents load_events(const std::string& path, const InputOptions& o) {
+    io::ReaderOptions ropts;
+    if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
+    ropts.csv_columns = o.csv_columns;
+    ropts.csv_time_unit = o.time_unit;
+    const auto reader = io::open_event_reader(path, ropts, o.format);
+    LoadedEvents out;
+    std::vector<Event> buf(1 << 16);
+    for (;;) {
+        const std::size_t n = reader->read(buf);
+        if (n == 0 && reader->skipped_in_batch().empty()) break;
+        out.events.insert(out.events.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+    out.size = reader->sensor().value_or(kDavis240);
+    return out;
+}
+
+void add_load_options(CLI::App& cmd, InputOptions& o) {
+    add_input_options(cmd, o.format, o.csv_columns, o.time_unit);
+    cmd.add_option("--size", o.size, "Sensor size WxH [default: the file's own, else 240x180]")
+        ->check([](const std::string& s) {
+            return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
+        });
+}
+
+void add_feature_track_options(CLI::App& cmd, eval::FeatureTrackParams& p, std::string& overlap) {
+    const auto group = "Feature tracks (docs/evaluation.md)";
+    cmd.add_option("--ft-inner", p.inner_radius, "Inner cylinder radius, px")->capture_default_str()->group(group);
+    cmd.add_option("--ft-outer", p.outer_radius, "Outer cylinder radius, px")->capture_default_str()->group(group);
+    cmd.add_option("--ft-min-inner", p.min_inner, "Corner events needed in the inner cylinder")
+        ->capture_default_str()
+        ->group(group);
+    cmd.add_option("--ft-max-outer-ratio", p.max_outer_ratio, "Largest outer-shell to inner ratio")
+        ->capture_default_str()
+        ->group(group);
+    cmd.add_option("--ft-max-duration", p.max_duration_us,
+                   "Longest hypothesis (time between its two corner events), microseconds")
+        ->capture_default_str()
+        ->group(group);
+    cmd.add_option("--ft-max-length", p.max_length, "Largest image distance between the two corner events, px")
+        ->capture_default_str()
+        ->group(group);
+    cmd.add_flag("--ft-per-polarity", p.same_polarity,
+                 "Pairs and cylinder contents of one polarity only [default: both polarities]")
+        ->group(group);
+    cmd.add_option("--ft-overlap", overlap,
+                   "Tracks sharing corners: any (a corner is correct if inner to any accepted track) or "
+                   "exclusive (accepted tracks claim their corners, anchors in time order)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"any", "exclusive"}))
+        ->group(group);
+}
+
+void finish_feature_track_params(eval::FeatureTrackParams& p, const std::string& overlap) {
+    p.overlap = eval::parse_track_overlap(overlap);
+    eval::validate(p);
+}
+
+std::vector<Event> detect_corners(const std::string& detector, const std::vector<Event>& events, SensorSize size,
+                                  const DetectorParams& params) {
+    AnyDetector det = make_detector(detector, size, params);
+    std::vector<std::uint8_t> flags(events.size());
+    std::visit([&](auto& d) { detect(d, std::span<const Event>(events), flags); }, det);
+    std::vector<Event> corners;
+    for (std::size_t i = 0; i < events.size(); ++i)
+        if (flags[i]) corners.push_back(events[i]);
+    return corners;
+}
+
+std::int64_t parse_time_option(const std::string& text, std::int64_t first_us, std::int64_t last_us) {
+    if (text.empty()) throw std::invalid_argument("empty time");
+    std::size_t used = 0;
+    double v = 0;
+    const bool rel = text[0] == '+' || text[0] == '-';
+    try {
+        v = std::stod(rel ? text.substr(1) : text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != text.size() - (rel ? 1 : 0) || !std::isfinite(v) || v < 0)
+        throw std::invalid_argument("bad time '" + text + "' (seconds, '+S' after the start or '-S' before the end)");
+    const auto us = static_cast<std::int64_t>(std::llround(v * 1e6));
+    if (text[0] == '+') return first_us + us;
+    if (text[0] == '-') return last_us - us;
+    return us;
+}
+
+}  // namespace evcorner::cli

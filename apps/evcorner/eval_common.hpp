@@ -1,0 +1,48 @@
+#pragma once
+// What label, eval and render share: loading a whole event file, running a detector
+// over it, parsing a time option, and the feature-track options.
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "evcorner/any_detector.hpp"
+#include "evcorner/eval/feature_tracks.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner::cli {
+
+struct InputOptions {
+    std::string format = "auto";
+    std::string csv_columns;
+    std::string time_unit = "us";
+    std::string size;  ///< WxH, empty: the file's own, else 240x180
+};
+
+struct LoadedEvents {
+    std::vector<Event> events;
+    SensorSize size;
+};
+
+/// Reads every event of `path` into memory (the evaluation needs random access).
+LoadedEvents load_events(const std::string& path, const InputOptions& o);
+
+/// Adds --format, --csv-columns, --time-unit and --size.
+void add_load_options(CLI::App& cmd, InputOptions& o);
+
+/// The feature-track parameters as options (--ft-*); `overlap` receives the name.
+void add_feature_track_options(CLI::App& cmd, eval::FeatureTrackParams& p, std::string& overlap);
+/// Completes `p` from the option strings; throws std::invalid_argument.
+void finish_feature_track_params(eval::FeatureTrackParams& p, const std::string& overlap);
+
+/// The corner events `detector` finds in `events` (a fresh detector).
+std::vector<Event> detect_corners(const std::string& detector, const std::vector<Event>& events, SensorSize size,
+                                  const DetectorParams& params = {});
+
+/// A time option: seconds on the stream's clock ("51.99"), or "+S" seconds after
+/// `first_us`, or "-S" seconds before `last_us`. Throws std::invalid_argument.
+std::int64_t parse_time_option(const std::string& text, std::int64_t first_us, std::int64_t last_us);
+
+}  // namespace evcorner::cli

@@ -1,0 +1,76 @@
+#pragma once
+// Feature-track ground truth (Mueggler, Bartolozzi, Scaramuzza, BMVC 2017, Sec. 3.1.2):
+// a corner event is "correct" when it lies on a feature track found in the corner
+// stream itself.
+//
+// A hypothesis is a pair of corner events a, b (t_a < t_b). Its axis is the straight
+// line through them in (x, y, t); the cylinders are oblique: at every time t in
+// [t_a, t_b] their cross-section is a disc centred on the axis point
+// c(t) = a + (b - a)(t - t_a)/(t_b - t_a). A corner event e is inner when
+// |e - c(t_e)| <= inner_radius, outer when inner_radius < |e - c(t_e)| <= outer_radius.
+// The hypothesis is accepted (a feature track) when inner >= min_inner and
+// outer <= max_outer_ratio * inner; its inner events are then labelled correct.
+// docs/evaluation.md explains every choice the paper leaves open (the defaults below).
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "evcorner/event.hpp"
+
+namespace evcorner::eval {
+
+/// How accepted tracks that share corner events combine.
+enum class TrackOverlap {
+    /// Every hypothesis is judged on all corners; a corner is correct when it is inner to
+    /// any accepted track (order-free, what "exhaustive search" implies).
+    any,
+    /// Hypotheses are tried with anchors in time order; an accepted track claims its inner
+    /// corners, and claimed corners take no further part (neither counted nor pairs).
+    exclusive,
+};
+
+struct FeatureTrackParams {
+    double inner_radius = 3.0;      ///< px (paper)
+    double outer_radius = 5.0;      ///< px (paper)
+    int min_inner = 30;             ///< inner corner events needed (paper)
+    double max_outer_ratio = 0.25;  ///< outer / inner at most this (paper)
+    /// Longest time between the two corner events of a hypothesis; the cylinder spans
+    /// exactly [t_a, t_b], so this is also the longest track segment.
+    std::int64_t max_duration_us = 100'000;
+    /// Largest image distance between the two corner events of a hypothesis (px).
+    double max_length = 20.0;
+    /// Pairs and cylinder contents of one polarity only (true), or of both (false).
+    bool same_polarity = false;
+    TrackOverlap overlap = TrackOverlap::any;
+    /// Side of the spatial buckets of the index (px); changes speed, never the labels.
+    int cell_size = 8;
+};
+
+/// Throws std::invalid_argument naming the first parameter out of range.
+void validate(const FeatureTrackParams& p);
+
+/// Parses "any" / "exclusive"; throws std::invalid_argument otherwise.
+TrackOverlap parse_track_overlap(std::string_view name);
+std::string_view to_string(TrackOverlap o) noexcept;
+
+struct FeatureTrackResult {
+    std::vector<std::uint8_t> on_track;  ///< one per corner event, in input order: 1 = correct
+    std::size_t labelled = 0;            ///< corners with on_track = 1
+    std::uint64_t hypotheses = 0;        ///< pairs evaluated
+    std::uint64_t accepted = 0;          ///< pairs accepted as feature tracks
+
+    /// FT: labelled / corners in percent (0 for no corners).
+    [[nodiscard]] double ft_percent() const noexcept {
+        return on_track.empty() ? 0.0 : 100.0 * static_cast<double>(labelled) / static_cast<double>(on_track.size());
+    }
+};
+
+/// Labels every corner event of `corners` (any order; time order is not required).
+/// Cost: a bucket index over (x, y) with time-sorted buckets; each anchor gathers only
+/// the corners inside its reachable space-time box, never all corners.
+FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& params = {});
+
+}  // namespace evcorner::eval

@@ -1,0 +1,57 @@
+#pragma once
+// The paper's figures (Mueggler et al., BMVC 2017) drawn from events and corner events.
+// Every figure is a pure function of its inputs: events in time order, a time `at`
+// (microseconds, the same clock as the events) or an interval, and a style.
+//
+//   render_sae            Fig. 2b: the SAE of one polarity, grey, newest bright.
+//   render_recent_corners Fig. 6:  events of the last 33 ms grey; corner events of the last
+//                                  33 ms bright and of the last 100 ms dark, green = ON, red = OFF.
+//   render_space_time     Fig. 1b / 5b: events and corner events over [t0, t1] in an oblique
+//                                  projection, time upwards; corners coloured by polarity, or
+//                                  by label (green on a feature track, red off it).
+
+#include <cstdint>
+#include <span>
+
+#include "evcorner/event.hpp"
+#include "evcorner/render/image.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner::render {
+
+inline constexpr Rgb kOnBright{40, 230, 40}, kOnDark{0, 110, 0};
+inline constexpr Rgb kOffBright{240, 40, 40}, kOffDark{120, 0, 0};
+inline constexpr Rgb kOnTrack{0, 170, 0}, kOffTrack{220, 0, 0};
+
+/// Fig. 2b: pixel value 255 (1 - (at - t) / window) for the newest event of `polarity`
+/// at or before `at`, 0 for older ones and pixels that never fired. One image pixel per
+/// sensor pixel.
+RgbImage render_sae(std::span<const Event> events, SensorSize size, int polarity, std::int64_t at,
+                    std::int64_t window_us);
+
+struct RecentCornersStyle {
+    std::int64_t events_window_us = 33'000;  ///< grey events of (at - this, at]
+    std::int64_t recent_us = 33'000;         ///< bright corners of (at - this, at]
+    std::int64_t older_us = 100'000;         ///< dark corners of (at - this, at - recent]
+    int corner_side = 3;                     ///< corner dot side, sensor pixels
+};
+
+/// Fig. 6 on black; one image pixel per sensor pixel.
+RgbImage render_recent_corners(std::span<const Event> events, std::span<const Event> corners, SensorSize size,
+                               std::int64_t at, const RecentCornersStyle& style = {});
+
+struct SpaceTimeStyle {
+    int scale = 2;            ///< image pixels per sensor pixel
+    int time_height = 360;    ///< image pixels (before scale) for the time axis
+    double depth = 0.5;       ///< image pixels per pixel of y, drawn up and to the right
+    int corner_side = 2;      ///< image pixels per corner dot, before scale
+};
+
+/// Fig. 1b (labels empty: corners green ON / red OFF) and Fig. 5b (labels given, one per
+/// corner: green on a track, red off it). Events and corners outside [t0, t1] are left out.
+/// White background; sensor box edges at t0 and t1 in grey.
+RgbImage render_space_time(std::span<const Event> events, std::span<const Event> corners,
+                           std::span<const std::uint8_t> labels, SensorSize size, std::int64_t t0,
+                           std::int64_t t1, const SpaceTimeStyle& style = {});
+
+}  // namespace evcorner::render
