@@ -84,7 +84,9 @@ void BinaryReader::outside(std::uint32_t x, std::uint32_t y, std::uint64_t at) {
 }
 
 void BinaryReader::backwards(std::int64_t t, std::uint64_t at) const {
-    fail(at, fmt::format("timestamp goes backwards ({} us before the previous event)", last_t_ - t));
+    // In unsigned arithmetic: the gap between two int64 times can exceed INT64_MAX.
+    const std::uint64_t gap = static_cast<std::uint64_t>(last_t_) - static_cast<std::uint64_t>(t);
+    fail(at, fmt::format("timestamp goes backwards ({} us before the previous event)", gap));
 }
 
 std::size_t BinaryReader::read(std::span<Event> out) {

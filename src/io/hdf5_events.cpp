@@ -304,7 +304,8 @@ std::size_t Hdf5Reader::read(std::span<Event> out) {
             }
             if (t_[k] < last_t_) [[unlikely]]
                 fail_at(chunk_start_ + k, 2,
-                        fmt::format("timestamp goes backwards ({} us before the previous event)", last_t_ - t_[k]));
+                        fmt::format("timestamp goes backwards ({} us before the previous event)",
+                                    static_cast<std::uint64_t>(last_t_) - static_cast<std::uint64_t>(t_[k])));
             last_t_ = t_[k];
             out[n++] = Event{t_[k], static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
                              static_cast<std::uint8_t>(p_[k] > 0)};
@@ -330,7 +331,7 @@ bool Hdf5Writer::filter_available(int id) {
 Hdf5Writer::Hdf5Writer(std::string path, Options options)
     : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdout>" : path), options_(options) {
     if (path == "-") throw OutputError(name_, "HDF5 files cannot go to standard output");
-    if (options_.chunk_events == 0) options_.chunk_events = std::size_t{1} << 16;
+    if (options_.chunk_events == 0) options_.chunk_events = std::size_t{1} << 14;
     impl_->file = Hid(quiet([&] { return H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT); }), H5Fclose);
     if (!impl_->file.ok()) throw OutputError(name_, "HDF5 cannot create the file");
     impl_->group = Hid(quiet([&] { return H5Gcreate2(impl_->file.get(), "events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT); }),

@@ -97,7 +97,7 @@ public:
         std::optional<SensorSize> sensor;
         /// 0: none; 1: deflate (built into HDF5); 32001: Blosc with ZSTD (needs the plugin).
         int filter = 0;
-        std::size_t chunk_events = std::size_t{1} << 16;
+        std::size_t chunk_events = std::size_t{1} << 14;
     };
     /// Whether HDF5 can use filter `id` (built in, or a plugin it finds).
     static bool filter_available(int id);

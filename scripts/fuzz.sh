@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (fuzz/) with clang++ in build-fuzz/ and runs each for
+# SECONDS_PER_TARGET seconds (default 60), seeded with the heads of the real recordings
+# (../shared/data/real, when present), the bundled data/ and fuzz/seeds/. Fails on any
+# crash, sanitizer report, timeout (> 10 s per input) or allocation over 2 GB; the
+# reproducer is left in build-fuzz/artifacts/. Prints the executions per target.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+secs="${1:-60}"
+root="$PWD"
+build="$root/build-fuzz"
+shared="$root/../shared/data/real"
+
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+  -DEVCORNER_FUZZ=ON -DEVCORNER_BUILD_APPS=OFF -DEVCORNER_BUILD_TESTS=OFF -DEVCORNER_BUILD_BENCH=OFF >/dev/null
+targets=(text csv aedat2 evt2 evt3 dat aedat4 hdf5 npy)
+cmake --build "$build" -j "${FUZZ_JOBS:-2}" --target "${targets[@]/#/fuzz_}" >/dev/null
+
+# Seeds: the first 64 KiB of each matching file (inputs are capped at that length).
+seed() {  # seed TARGET FILE...
+  local dir="$build/corpus/$1"; shift
+  mkdir -p "$dir"
+  for f in "$@"; do
+    [ -f "$f" ] && head -c 65536 "$f" >"$dir/seed-$(basename "$(dirname "$f")")-$(basename "$f")"
+  done
+  return 0
+}
+rm -rf "$build/corpus"
+shopt -s nullglob
+seed text fuzz/seeds/seed.txt data/ecd/*/events.txt "$shared"/ecd-stppp/shapes_rotation/events.txt
+seed csv fuzz/seeds/seed.csv
+seed npy fuzz/seeds/seed.npy
+seed hdf5 fuzz/seeds/*.h5
+seed aedat4 fuzz/seeds/seed.aedat4 "$shared"/*/*.aedat4
+seed aedat2 "$shared"/davis240c-imu-pyaedattools/*.aedat "$shared"/dvs128-walking-ouyang/neal_walking.aedat
+seed evt2 "$shared"/expelliarmus/evt2_sample.raw "$shared"/faery-testdata/evt2.raw
+seed evt3 "$shared"/expelliarmus/evt3_sample.raw
+seed dat "$shared"/tonic-testdata/sample_ncars.dat
+
+mkdir -p "$build/artifacts" "$build/logs"
+failed=()
+for t in "${targets[@]}"; do
+  log="$build/logs/fuzz_$t.log"
+  if "$build/bin/fuzz_$t" "$build/corpus/$t" -max_total_time="$secs" -rss_limit_mb=2048 -timeout=10 \
+       -max_len=65536 -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" >"$log" 2>&1; then
+    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
+    echo "fuzz_$t: ok, $runs executions in ${secs} s"
+  else
+    echo "fuzz_$t: FAILED (log: $log)" >&2
+    grep -m 5 -E 'ERROR|SUMMARY|Test unit written' "$log" >&2 || tail -5 "$log" >&2
+    failed+=("$t")
+  fi
+done
+if ((${#failed[@]} > 0)); then
+  echo "fuzz: failures in: ${failed[*]}" >&2
+  exit 1
+fi
