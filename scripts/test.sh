@@ -6,3 +6,6 @@ cd "$(dirname "$0")/.."
 scripts/setup-debian.sh
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)"
+if [ "${CI:-}" = "true" ]; then
+  scripts/fuzz.sh 20
+fi
