@@ -11,42 +11,42 @@
 // exactly L pixels of the circle are at least as new as the arc's oldest. Any arc that
 // fires is found this way, because while the grown arc is a proper part of the firing
 // set, one of its neighbours is in that set and newer than everything outside it.
+// Before growing, an exact cheap test rejects most circles (see arc_fires_from()).
 // arc_fires_naive() is the definition written plainly; tests hold the two together.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 
 namespace evcorner {
 
 namespace detail {
-// #values in t[0..N) that are >= v. Kept scalar on purpose: without SSE4.2 the
-// auto-vectorised 64-bit compare costs several times more instructions.
+// #values in t[0..N) that are >= v, unrolled.
+template <std::size_t... K>
+inline int count_at_least(const std::int64_t* t, std::int64_t v, std::index_sequence<K...>) noexcept {
+    return (static_cast<int>(t[K] >= v) + ...);
+}
 template <int N>
-#if defined(__GNUC__) && !defined(__clang__)
-__attribute__((optimize("no-tree-vectorize")))
-#endif
 inline int count_at_least(const std::int64_t* t, std::int64_t v) noexcept {
-    int n = 0;
-    for (int k = 0; k < N; ++k) n += t[k] >= v;
-    return n;
+    return count_at_least(t, v, std::make_index_sequence<N>{});
+}
+
+// Branch-free select: the per-event paths must not mispredict on data.
+inline int select(bool c, int a, int b) noexcept {
+    const int m = -static_cast<int>(c);
+    return (a & m) | (b & ~m);
 }
 }  // namespace detail
 
-/// `t` holds the circle twice: t[k] == t[k + N] for 0 <= k < N, so that no index
-/// along an arc needs a modulo.
+/// The arc test given the circle twice (t[k] == t[k + N], so that no index along an
+/// arc needs a modulo) and the index of one of its newest pixels.
 template <int N, int Lmin, int Lmax>
-[[nodiscard]] inline bool arc_fires(const std::int64_t* t) noexcept {
+[[nodiscard]] inline bool arc_fires_from(const std::int64_t* t, int newest) noexcept {
     static_assert(2 <= Lmin && Lmin <= Lmax && 2 * Lmax - 2 < N);
-    int newest = 0;
-    std::int64_t top = t[0];
-    for (int k = 1; k < N; ++k) {
-        const bool newer = t[k] > top;
-        newest = newer ? k : newest;
-        top = newer ? t[k] : top;
-    }
     // Centre the work on a copy of the newest pixel whose +-(Lmax-1) neighbourhood
     // and opposite side all lie inside [0, 2N).
-    const int c = newest < Lmax ? newest + N : newest;
+    const int c = newest + N * static_cast<int>(newest < Lmax);
 
     // Cheap rejection, exact: a firing arc holds the newest pixel and at least Lmin
     // pixels, so its oldest is at most `bound`, the best oldest of the Lmin-windows
@@ -58,14 +58,18 @@ template <int N, int Lmin, int Lmax>
         for (int k = 1; k < Lmin; ++k) w = t[c - s + k] < w ? t[c - s + k] : w;
         bound = w > bound ? w : bound;
     }
-    for (int k = c + Lmax; k <= c + N - Lmax; ++k)
-        if (t[k] >= bound) return false;
+    std::int64_t opposite = t[c + Lmax];
+    for (int k = c + Lmax + 1; k <= c + N - Lmax; ++k) opposite = t[k] > opposite ? t[k] : opposite;
+    if (opposite >= bound) return false;
 
-    // Grow the arc [lo, hi] from c, taking the newer neighbour each time.
+    // Grow the arc [lo, hi] from c, taking the newer neighbour each time; at each
+    // length in range it fires iff exactly `len` pixels are at least as new as its
+    // oldest. Branch-free: the outcome is data, and data mispredicts.
     int lo = c;
     int hi = c;
-    std::int64_t oldest = top;
-    int at_least_oldest = -1;  // #pixels with t >= oldest; -1 = stale
+    std::int64_t oldest = t[c];
+    bool fires = false;
+#pragma GCC unroll 8
     for (int len = 2; len <= Lmax; ++len) {
         const std::int64_t left = t[lo - 1];
         const std::int64_t right = t[hi + 1];
@@ -73,27 +77,34 @@ template <int N, int Lmin, int Lmax>
         const std::int64_t taken = go_left ? left : right;
         lo -= go_left;
         hi += !go_left;
-        if (taken < oldest) {
-            oldest = taken;
-            at_least_oldest = -1;
-        }
-        if (len < Lmin) continue;
-        if (at_least_oldest < 0) {
-            at_least_oldest = detail::count_at_least<N>(t, oldest);
-            // The count only grows as the arc grows; past Lmax nothing can fire.
-            if (at_least_oldest > Lmax) return false;
-        }
-        if (at_least_oldest == len) return true;
+        oldest = taken < oldest ? taken : oldest;
+        if (len >= Lmin) fires |= detail::count_at_least<N>(t, oldest) == len;
     }
-    return false;
+    return fires;
 }
 
-/// The same test on N values, doubling them first.
+/// Gathers the circle around `centre` (pixel k at centre[offset(k)]) and runs the test.
+template <int N, int Lmin, int Lmax, class Offset>
+[[nodiscard]] inline bool circle_fires(const std::int64_t* centre, Offset offset) noexcept {
+    std::int64_t t[2 * N];
+    int newest = 0;
+    std::int64_t top = centre[offset(0)];
+    t[0] = t[N] = top;
+#pragma GCC unroll 32
+    for (int k = 1; k < N; ++k) {
+        const std::int64_t v = centre[offset(k)];
+        t[k] = t[k + N] = v;
+        const bool newer = v > top;
+        newest = detail::select(newer, k, newest);
+        top = v > top ? v : top;
+    }
+    return arc_fires_from<N, Lmin, Lmax>(t, newest);
+}
+
+/// The arc test on N values.
 template <int N, int Lmin, int Lmax>
 [[nodiscard]] inline bool arc_fires(const std::array<std::int64_t, N>& t) noexcept {
-    std::array<std::int64_t, 2 * N> twice;
-    for (int k = 0; k < N; ++k) twice[k] = twice[k + N] = t[k];
-    return arc_fires<N, Lmin, Lmax>(twice.data());
+    return circle_fires<N, Lmin, Lmax>(t.data(), [](int k) { return k; });
 }
 
 template <int N, int Lmin, int Lmax>

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/event.hpp"
@@ -24,11 +25,26 @@ public:
     static constexpr int kArc3Min = 3, kArc3Max = 6;
     static constexpr int kArc4Min = 4, kArc4Max = 8;
 
-    explicit EFast(SensorSize size);
+    explicit EFast(SensorSize size) : sae_(size) {}
 
     /// Updates the SAE with `e` and answers whether `e` is a corner event.
     /// `e` must lie on the sensor (readers validate).
-    bool process(const Event& e) noexcept;
+    bool process(const Event& e) noexcept {
+        sae_.update(e);
+        const SensorSize s = sae_.size();
+        if (e.x < kCircleMargin || e.x >= s.width - kCircleMargin || e.y < kCircleMargin ||
+            e.y >= s.height - kCircleMargin)
+            return false;
+        const std::int64_t* centre =
+            sae_.plane(e.p) + static_cast<std::ptrdiff_t>(e.y) * s.width + e.x;
+        // Offsets from compile-time circle coordinates: the loads address rows
+        // centre + dy * width with constant column offsets.
+        const std::ptrdiff_t w = s.width;
+        return circle_fires<kCircle3.size(), kArc3Min, kArc3Max>(
+                   centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }) &&
+               circle_fires<kCircle4.size(), kArc4Min, kArc4Max>(
+                   centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
+    }
 
     [[nodiscard]] const Sae& sae() const noexcept { return sae_; }
     [[nodiscard]] SensorSize size() const noexcept { return sae_.size(); }
@@ -36,8 +52,6 @@ public:
 
 private:
     Sae sae_;
-    std::array<std::ptrdiff_t, kCircle3.size()> off3_{};  // circle offsets in one SAE plane
-    std::array<std::ptrdiff_t, kCircle4.size()> off4_{};
 };
 static_assert(Detector<EFast>);
 
