@@ -170,7 +170,22 @@ FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const Fe
         const std::int32_t* w = c.weight.data();
 
         // Partners in time order; `end` is one past the last candidate with t <= t_b.
+        // any: every accepted hypothesis labels its inner corners at once. exclusive: the
+        // anchor keeps its accepted hypothesis with the most inner corners, which claims them.
         std::size_t end = 0;
+        std::int32_t best_inner = -1;
+        std::size_t best_j = 0, best_end = 0;
+        auto label_inner = [&](std::size_t j, std::size_t stop) {
+            const float inv = 1.0f / dt[j];
+            for (std::size_t k = 0; k < stop; ++k) {
+                const float s = dt[k] * inv;
+                const float ex = dx[k] - dx[j] * s, ey = dy[k] - dy[j] * s;
+                if (ex * ex + ey * ey <= r_in2 && w[k] != 0) {
+                    on_track[c.pos[k]] = 1;
+                    if (exclusive) claimed[c.pos[k]] = 1;
+                }
+            }
+        };
         for (std::size_t j = 0; j < m; ++j) {
             if (dt[j] <= 0.0f) continue;  // a pair needs t_b > t_a
             while (end < m && dt[end] <= dt[j]) ++end;
@@ -194,19 +209,15 @@ FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const Fe
                 static_cast<double>(outer) > p.max_outer_ratio * static_cast<double>(inner))
                 continue;
             ++result.accepted;
-            for (std::size_t k = 0; k < end; ++k) {
-                const float s = dt[k] * inv;
-                const float ex = dx[k] - bx * s, ey = dy[k] - by * s;
-                if (ex * ex + ey * ey <= r_in2 && w[k] != 0) {
-                    on_track[c.pos[k]] = 1;
-                    if (exclusive) {
-                        claimed[c.pos[k]] = 1;
-                        c.weight[k] = 0;
-                    }
-                }
+            if (!exclusive) {
+                label_inner(j, end);
+            } else if (inner > best_inner) {
+                best_inner = inner;
+                best_j = j;
+                best_end = end;
             }
-            if (exclusive) break;  // the anchor itself is claimed now
         }
+        if (exclusive && best_inner >= 0) label_inner(best_j, best_end);
     }
     for (std::size_t i = 0; i < n; ++i) {
         result.on_track[ix.original[i]] = on_track[i];

@@ -27,8 +27,8 @@ enum class TrackOverlap {
     /// Every hypothesis is judged on all corners; a corner is correct when it is inner to
     /// any accepted track (order-free, what "exhaustive search" implies).
     any,
-    /// Hypotheses are tried with anchors in time order; an accepted track claims its inner
-    /// corners, and claimed corners take no further part (neither counted nor pairs).
+    /// Anchors in time order; of an anchor's accepted hypotheses, the one with the most inner
+    /// corners claims them, and claimed corners take no further part (neither counted nor pairs).
     exclusive,
 };
 
