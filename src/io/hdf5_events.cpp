@@ -144,7 +144,19 @@ Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
                                                     "install {}",
                                                     names[i], id, filter_hint(id)));
         }
-        if (i == 0 && dcpl.ok() && H5Pget_layout(dcpl.get()) == H5D_CHUNKED) {
+        // libhdf5 1.10 trusts a compact or contiguous dataset's size field and reads past
+        // its buffer when the field is too small for the dataspace (found by fuzz_hdf5).
+        const H5D_layout_t lay = dcpl.ok() ? H5Pget_layout(dcpl.get()) : H5D_LAYOUT_ERROR;
+        if (lay == H5D_COMPACT || lay == H5D_CONTIGUOUS) {
+            const hsize_t need = dims[0] * H5Tget_size(type.get());
+            if (need / std::max<std::size_t>(H5Tget_size(type.get()), 1) != dims[0] ||
+                quiet([&] { return H5Dget_storage_size(d); }) < need)
+                throw InputError(name_, fmt::format("dataset {} stores fewer bytes than its {} values need (damaged)",
+                                                    names[i], dims[0]));
+        } else if (lay != H5D_CHUNKED) {
+            throw InputError(name_, fmt::format("dataset {} has an unsupported storage layout", names[i]));
+        }
+        if (i == 0 && lay == H5D_CHUNKED) {
             hsize_t c = 0;
             if (H5Pget_chunk(dcpl.get(), 1, &c) == 1) impl_->chunk = c;
         }
