@@ -165,7 +165,9 @@ TEST(FeatureTracks, TracksAmidClutterInAnyOrder) {
     const auto x = label_feature_tracks(shuffled.corners, p);
     std::size_t on_tracks = 0;
     for (std::size_t i = 0; i < x.on_track.size(); ++i) {
-        if (!shuffled.truth[i]) EXPECT_EQ(x.on_track[i], 0) << "clutter labelled at " << i;
+        if (!shuffled.truth[i]) {
+            EXPECT_EQ(x.on_track[i], 0) << "clutter labelled at " << i;
+        }
         on_tracks += x.on_track[i] & shuffled.truth[i];
     }
     EXPECT_GE(on_tracks, 135u);
