@@ -1,6 +1,6 @@
 // Feature-track labelling speed (issue 4 target: 100 000 corner events under 10 s on
 // one core). Two inputs of >= 100 000 corner events:
-//  - synthetic: 200 straight tracks (60 events each, 1 px jitter) per 100 ms window plus
+//  - synthetic: 100 straight tracks (60 events each, 1 px jitter) per 100 ms window plus
 //    25 % uniform clutter, repeated along time;
 //  - real: the eFAST corners of the Event-Camera-Dataset cuts, replayed end to end
 //    (each copy shifted in time) until 100 000 corners.
@@ -31,7 +31,7 @@ std::vector<Event> synthetic() {
     std::vector<Event> out;
     for (std::int64_t window = 0; out.size() < kCorners; window += 100'000) {
         std::uniform_int_distribution<std::int64_t> ct(window, window + 99'999);
-        for (int k = 0; k < 200; ++k) {
+        for (int k = 0; k < 100; ++k) {
             const double x0 = px(rng), y0 = py(rng), vx = v(rng), vy = v(rng);
             const int p = pol(rng);
             for (int i = 0; i < 60; ++i) {
@@ -42,7 +42,7 @@ std::vector<Event> synthetic() {
                                static_cast<std::uint16_t>(y), static_cast<std::uint8_t>(p)});
             }
         }
-        for (int k = 0; k < 3000; ++k)
+        for (int k = 0; k < 1500; ++k)
             out.push_back({ct(rng), static_cast<std::uint16_t>(cx(rng)), static_cast<std::uint16_t>(cy(rng)),
                            static_cast<std::uint8_t>(pol(rng))});
     }
