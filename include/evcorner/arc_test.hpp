@@ -8,7 +8,7 @@
 // arc_fires() is the linear-time form: a firing arc holds the circle's newest pixel and
 // is exactly the set of the L newest pixels. Grow an arc from the newest pixel, always
 // taking the newer of its two neighbours; at each length L in range the arc fires iff
-// exactly L pixels of the circle are at least as new as the arc's oldest. Any arc that
+// its oldest is strictly newer than every pixel outside it. Any arc that
 // fires is found this way, because while the grown arc is a proper part of the firing
 // set, one of its neighbours is in that set and newer than everything outside it.
 // Before growing, an exact cheap test rejects most circles (see arc_fires_from()).
@@ -22,20 +22,49 @@
 namespace evcorner {
 
 namespace detail {
-// #values in t[0..N) that are >= v, unrolled.
-template <std::size_t... K>
-inline int count_at_least(const std::int64_t* t, std::int64_t v, std::index_sequence<K...>) noexcept {
-    return (static_cast<int>(t[K] >= v) + ...);
-}
-template <int N>
-inline int count_at_least(const std::int64_t* t, std::int64_t v) noexcept {
-    return count_at_least(t, v, std::make_index_sequence<N>{});
-}
-
 // Branch-free select: the per-event paths must not mispredict on data.
 inline int select(bool c, int a, int b) noexcept {
     const int m = -static_cast<int>(c);
     return (a & m) | (b & ~m);
+}
+inline std::int64_t select(bool c, std::int64_t a, std::int64_t b) noexcept {
+    const std::int64_t m = -static_cast<std::int64_t>(c);
+    return (a & m) | (b & ~m);
+}
+inline std::int64_t max(std::int64_t a, std::int64_t b) noexcept { return a > b ? a : b; }
+inline std::int64_t min(std::int64_t a, std::int64_t b) noexcept { return a < b ? a : b; }
+
+// A value and its position on the circle; newer() keeps the newer of two.
+struct Newest {
+    std::int64_t t;
+    int k;
+};
+inline Newest newer(Newest a, Newest b) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+    // One compare, two conditional moves. Written out because the compiler, left to
+    // itself, turns some of these selects into branches, and they mispredict.
+    __asm__("cmpq %[bt], %[at]\n\t"
+            "cmovlq %[bt], %[at]\n\t"
+            "cmovll %[bk], %[ak]"
+            : [at] "+r"(a.t), [ak] "+r"(a.k)
+            : [bt] "r"(b.t), [bk] "r"(b.k)
+            : "cc");
+    return a;
+#else
+    const bool g = b.t > a.t;
+    return {max(a.t, b.t), select(g, b.k, a.k)};
+#endif
+}
+// The newest of t[K...] by a balanced tournament: N-1 comparisons in log2(N) rounds
+// rather than one serial chain of N.
+template <int Lo, int Hi>
+inline Newest newest_of(const std::int64_t* t) noexcept {
+    if constexpr (Hi - Lo == 1) {
+        return {t[Lo], Lo};
+    } else {
+        constexpr int Mid = Lo + (Hi - Lo) / 2;
+        return newer(newest_of<Lo, Mid>(t), newest_of<Mid, Hi>(t));
+    }
 }
 }  // namespace detail
 
@@ -44,6 +73,8 @@ inline int select(bool c, int a, int b) noexcept {
 template <int N, int Lmin, int Lmax>
 [[nodiscard]] inline bool arc_fires_from(const std::int64_t* t, int newest) noexcept {
     static_assert(2 <= Lmin && Lmin <= Lmax && 2 * Lmax - 2 < N);
+    using detail::max;
+    using detail::min;
     // Centre the work on a copy of the newest pixel whose +-(Lmax-1) neighbourhood
     // and opposite side all lie inside [0, 2N).
     const int c = newest + N * static_cast<int>(newest < Lmax);
@@ -55,30 +86,42 @@ template <int N, int Lmin, int Lmax>
     std::int64_t bound = INT64_MIN;
     for (int s = 0; s < Lmin; ++s) {
         std::int64_t w = t[c - s];
-        for (int k = 1; k < Lmin; ++k) w = t[c - s + k] < w ? t[c - s + k] : w;
-        bound = w > bound ? w : bound;
+        for (int k = 1; k < Lmin; ++k) w = min(w, t[c - s + k]);
+        bound = max(bound, w);
     }
     std::int64_t opposite = t[c + Lmax];
-    for (int k = c + Lmax + 1; k <= c + N - Lmax; ++k) opposite = t[k] > opposite ? t[k] : opposite;
+    for (int k = c + Lmax + 1; k <= c + N - Lmax; ++k) opposite = max(opposite, t[k]);
     if (opposite >= bound) return false;
 
-    // Grow the arc [lo, hi] from c, taking the newer neighbour each time; at each
-    // length in range it fires iff exactly `len` pixels are at least as new as its
-    // oldest. Branch-free: the outcome is data, and data mispredicts.
-    int lo = c;
-    int hi = c;
+    // The arc [c-a, c+b] (a, b < Lmax) leaves outside it the pixels c+b+1 .. c+N-a-1,
+    // that is right[b] = newest of t[c+b+1 .. c+N-Lmax] and left[a] = newest of
+    // t[c-Lmax+1 .. c-a-1]: suffix maxima, so that each length costs O(1) below.
+    std::int64_t right[Lmax];
+    std::int64_t left[Lmax];
+    right[Lmax - 1] = opposite;
+    left[Lmax - 1] = INT64_MIN;
+#pragma GCC unroll 8
+    for (int j = Lmax - 2; j >= 0; --j) {
+        right[j] = max(right[j + 1], t[c + j + 1]);
+        left[j] = max(left[j + 1], t[c - j - 1]);
+    }
+
+    // Grow the arc from c, taking the newer neighbour each time; at each length in
+    // range it fires iff its oldest is strictly newer than everything outside it.
+    // Branch-free: the outcome is data, and data mispredicts.
+    int a = 0;
+    int b = 0;
     std::int64_t oldest = t[c];
     bool fires = false;
 #pragma GCC unroll 8
     for (int len = 2; len <= Lmax; ++len) {
-        const std::int64_t left = t[lo - 1];
-        const std::int64_t right = t[hi + 1];
-        const bool go_left = left > right;
-        const std::int64_t taken = go_left ? left : right;
-        lo -= go_left;
-        hi += !go_left;
-        oldest = taken < oldest ? taken : oldest;
-        if (len >= Lmin) fires |= detail::count_at_least<N>(t, oldest) == len;
+        const std::int64_t l = t[c - a - 1];
+        const std::int64_t r = t[c + b + 1];
+        const bool go_left = l > r;
+        a += go_left;
+        b += !go_left;
+        oldest = min(oldest, max(l, r));
+        if (len >= Lmin) fires |= oldest > max(left[a], right[b]);
     }
     return fires;
 }
@@ -87,17 +130,9 @@ template <int N, int Lmin, int Lmax>
 template <int N, int Lmin, int Lmax, class Offset>
 [[nodiscard]] inline bool circle_fires(const std::int64_t* centre, Offset offset) noexcept {
     std::int64_t t[2 * N];
-    int newest = 0;
-    std::int64_t top = centre[offset(0)];
-    t[0] = t[N] = top;
 #pragma GCC unroll 32
-    for (int k = 1; k < N; ++k) {
-        const std::int64_t v = centre[offset(k)];
-        t[k] = t[k + N] = v;
-        const bool newer = v > top;
-        newest = detail::select(newer, k, newest);
-        top = v > top ? v : top;
-    }
+    for (int k = 0; k < N; ++k) t[k] = t[k + N] = centre[offset(k)];
+    const int newest = detail::newest_of<0, N>(t).k;
     return arc_fires_from<N, Lmin, Lmax>(t, newest);
 }
 
