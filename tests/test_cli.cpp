@@ -113,6 +113,15 @@ TEST_F(Cli, ReadsStandardInput) {
     EXPECT_EQ(from_stdin.out, from_file.out);
 }
 
+TEST_F(Cli, ReadsBinaryFormatsFromStandardInputToo) {
+    ASSERT_EQ(run("convert '" + sample_.string() + "' events.npy -q").status, 0);
+    const Result from_file = run("detect events.npy -q");
+    const Result from_stdin = run("detect - -q", (dir_ / "events.npy").string());
+    ASSERT_EQ(from_stdin.status, 0) << from_stdin.err;
+    EXPECT_FALSE(from_file.out.empty());
+    EXPECT_EQ(from_stdin.out, from_file.out);
+}
+
 TEST_F(Cli, MalformedLineStopsWithFileLineAndKeepsWholeLines) {
     std::string content = slurp(sample_);
     content += "52.1 12 oops 1\n52.2 1 1 1\n";

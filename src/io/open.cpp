@@ -43,8 +43,8 @@ bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(
 }  // namespace
 
 std::string detect_format(const std::string& path) {
-    if (path == "-") return "ecd-text";
-    const std::string head = head_of(path, 1 << 16);
+    // From a pipe, wait for no more than a header's worth of bytes.
+    const std::string head = path == "-" ? std::string(peek_stdin(1 << 14)) : head_of(path, 1 << 16);
     if (starts_with(head, "#!AER-DAT2.0")) return "aedat2";
     if (starts_with(head, kAedat4Magic)) return "aedat4";
     if (starts_with(head, kHdf5Magic)) return "hdf5";
@@ -90,7 +90,10 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
     }
     if (fmt_name == "aedat2" || fmt_name == "aedat") return std::make_unique<Aedat2Reader>(path, options);
     if (fmt_name == "aedat4") return std::make_unique<Aedat4Reader>(path, options);
-    if (fmt_name == "hdf5" || fmt_name == "h5") return std::make_unique<Hdf5Reader>(path, options);
+    if (fmt_name == "hdf5" || fmt_name == "h5") {
+        if (path == "-") throw InputError("<stdin>", "HDF5 needs a file it can seek in; standard input cannot be read as HDF5");
+        return std::make_unique<Hdf5Reader>(path, options);
+    }
     if (fmt_name == "csv") return std::make_unique<CsvReader>(path, options);
     if (fmt_name == "evt3") return std::make_unique<Evt3Reader>(path, options);
     if (fmt_name == "evt2") return std::make_unique<Evt2Reader>(path, options);

@@ -6,8 +6,13 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 
 namespace evcorner::io {
+
+/// The first bytes of standard input, read once and kept, so that a format can be told
+/// from its content before a reader opens "-"; that reader then gets them first.
+std::string_view peek_stdin(std::size_t max_bytes);
 
 class InputFile {
 public:
