@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
         "  evcorner info recording.aedat                 # what a file holds (AEDAT2, EVT2/3, DAT, CSV, npy)\n"
         "  evcorner convert recording.raw events.npy     # any readable format to text, CSV or npy\n"
         "  evcorner eval data/ecd --report report        # the paper's Tables 1 and 2, figures\n"
+        "  evcorner bench events.txt                     # ns/event, max rate, latency on this machine\n"
         "Exit status: 0 on success, 1 on bad input or a failed write, 2 on a usage error.");
     evcorner::cli::add_detect_command(app);
     evcorner::cli::add_info_command(app);
@@ -28,6 +29,7 @@ int main(int argc, char** argv) {
     evcorner::cli::add_label_command(app);
     evcorner::cli::add_eval_command(app);
     evcorner::cli::add_render_command(app);
+    evcorner::cli::add_bench_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,456 @@
+// evcorner bench: the paper's Table 2 (time per event, maximum event rate) for this
+// machine, on any input, rerunnable by anyone.
+//
+// Method. Each input is read into memory once, then replayed back to back until the
+// stream holds at least --min-events events; repetition r is shifted by r x (span + 1 us)
+// so that time keeps increasing. Per detector:
+//  - throughput: --repeat passes over the whole stream, each with a freshly built detector
+//    (construction not timed), timed with steady_clock around detect() alone; ns/event
+//    median, min and max over the passes; max event rate = 1e9 / median ns/event.
+//  - latency: one more pass timing every event on its own with the time-stamp counter
+//    (rdtscp ... lfence around each process() call; TSC ticks converted to ns by
+//    calibrating against steady_clock over that pass). The median cost of an empty timed
+//    section (the clock's own overhead) is measured first and subtracted; it is printed.
+//    The timed pass runs slower than the throughput passes (the fences stop events from
+//    overlapping), so its percentiles bound a single event's latency from above.
+// Data flows one way: the timing wraps the loop; the detectors know nothing of it.
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <fmt/format.h>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#define EVCORNER_HAVE_TSC 1
+#endif
+
+#include "commands.hpp"
+#include "evcorner/any_detector.hpp"
+#include "evcorner/detector.hpp"
+#include "evcorner/io/open.hpp"
+#include "evcorner/io/output_file.hpp"
+
+#ifndef EVCORNER_BUILD_TYPE
+#define EVCORNER_BUILD_TYPE "unknown"
+#endif
+#ifndef EVCORNER_BUILD_FLAGS
+#define EVCORNER_BUILD_FLAGS "unknown"
+#endif
+
+namespace evcorner::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct BenchOptions {
+    std::vector<std::string> inputs;
+    std::string detectors = "efast,harris,harris-global";
+    int repeat = 5;
+    std::uint64_t min_events = 10'000'000;
+    std::string json;
+    std::string format = "auto";
+    std::string csv_columns;
+    std::string time_unit = "us";
+    std::string size;
+    bool no_latency = false;
+    bool quiet = false;
+};
+
+struct Row {
+    std::string input;
+    std::string detector;
+    SensorSize sensor;
+    std::uint64_t file_events = 0;
+    std::uint64_t events = 0;  // after replay
+    std::uint64_t corners = 0;
+    std::vector<double> ns_per_event;  // one per pass
+    double median = 0, min = 0, max = 0;
+    double p50 = 0, p99 = 0, p999 = 0;  // ns; 0 when not measured
+    std::size_t memory = 0;
+};
+
+// ----------------------------------------------------------------- machine description
+
+std::string cpu_model() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line, name, family, model, stepping;
+    auto value = [](const std::string& l) {
+        const auto c = l.find(':');
+        std::string v = c == std::string::npos ? "" : l.substr(c + 1);
+        v.erase(0, v.find_first_not_of(" \t"));
+        return v;
+    };
+    while (std::getline(in, line)) {
+        if (line.empty() && !name.empty()) break;  // first processor only
+        if (line.rfind("model name", 0) == 0) name = value(line);
+        else if (line.rfind("cpu family", 0) == 0) family = value(line);
+        else if (line.rfind("model", 0) == 0 && line.rfind("model name", 0) != 0) model = value(line);
+        else if (line.rfind("stepping", 0) == 0) stepping = value(line);
+    }
+    if (name.empty()) name = "unknown CPU";
+    if (!family.empty()) name += fmt::format(" (family {}, model {}, stepping {})", family, model, stepping);
+    return name;
+}
+
+std::string compiler() {
+#if defined(__clang__)
+    return "clang " __clang_version__;
+#elif defined(__GNUC__)
+    return "g++ " __VERSION__;
+#else
+    return "unknown compiler";
+#endif
+}
+
+// ----------------------------------------------------------------- input
+
+std::vector<Event> load(const std::string& path, const BenchOptions& o, SensorSize& sensor) {
+    io::ReaderOptions ropts;
+    if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
+    ropts.csv_columns = o.csv_columns;
+    ropts.csv_time_unit = o.time_unit;
+    auto reader = io::open_event_reader(path, ropts, o.format);
+    std::vector<Event> events;
+    std::vector<Event> batch(1 << 16);
+    for (;;) {
+        const std::size_t n = reader->read(batch);
+        if (n == 0 && reader->skipped_in_batch().empty()) break;
+        events.insert(events.end(), batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+    sensor = reader->sensor().value_or(kDavis240);
+    return events;
+}
+
+/// The file's events repeated until there are at least `min_events`, each repetition
+/// shifted in time past the previous one.
+std::vector<Event> replay(const std::vector<Event>& file, std::uint64_t min_events) {
+    if (file.empty()) return {};
+    const std::uint64_t reps = std::max<std::uint64_t>(1, (min_events + file.size() - 1) / file.size());
+    const std::int64_t shift = file.back().t - file.front().t + 1;
+    std::vector<Event> out;
+    out.reserve(reps * file.size());
+    for (std::uint64_t r = 0; r < reps; ++r) {
+        const std::int64_t dt = static_cast<std::int64_t>(r) * shift;
+        for (Event e : file) {
+            e.t += dt;
+            out.push_back(e);
+        }
+    }
+    return out;
+}
+
+// ----------------------------------------------------------------- timing
+
+double median_of(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+#ifdef EVCORNER_HAVE_TSC
+inline std::uint64_t tsc_begin() noexcept {
+    _mm_lfence();
+    return __rdtsc();
+}
+inline std::uint64_t tsc_end() noexcept {
+    unsigned aux;
+    const std::uint64_t t = __rdtscp(&aux);
+    _mm_lfence();
+    return t;
+}
+#endif
+
+struct Latency {
+    double p50 = 0, p99 = 0, p999 = 0;
+    double overhead_ns = 0;
+    double resolution_ns = 0;
+};
+
+/// Times every event on its own; returns percentiles in ns, clock overhead removed.
+template <class D>
+Latency time_each_event(D& det, const std::vector<Event>& events) {
+    Latency out;
+#ifdef EVCORNER_HAVE_TSC
+    std::vector<std::uint32_t> ticks(events.size());
+    // The timer's own cost: the median of empty timed sections.
+    std::vector<std::uint32_t> empty(100'000);
+    for (auto& e : empty) {
+        const std::uint64_t a = tsc_begin();
+        const std::uint64_t b = tsc_end();
+        e = static_cast<std::uint32_t>(b - a);
+    }
+    std::nth_element(empty.begin(), empty.begin() + static_cast<std::ptrdiff_t>(empty.size() / 2), empty.end());
+    const std::uint32_t overhead = empty[empty.size() / 2];
+    // The counter's step: the smallest non-zero difference of back-to-back reads.
+    std::uint64_t step = UINT64_MAX;
+    for (int i = 0; i < 10'000; ++i) {
+        const std::uint64_t a = __rdtsc();
+        const std::uint64_t b = __rdtsc();
+        if (b > a) step = std::min(step, b - a);
+    }
+
+    volatile std::uint8_t sink = 0;
+    const auto c0 = Clock::now();
+    const std::uint64_t k0 = __rdtsc();
+    for (std::size_t i = 0; i < events.size(); ++i) {
+        const std::uint64_t a = tsc_begin();
+        const bool c = det.process(events[i]);
+        const std::uint64_t b = tsc_end();
+        sink = sink + static_cast<std::uint8_t>(c);
+        const std::uint64_t d = b - a;
+        ticks[i] = d > overhead ? static_cast<std::uint32_t>(std::min<std::uint64_t>(d - overhead, UINT32_MAX)) : 0;
+    }
+    const std::uint64_t k1 = __rdtsc();
+    const double seconds = std::chrono::duration<double>(Clock::now() - c0).count();
+    const double ns_per_tick = seconds * 1e9 / static_cast<double>(k1 - k0);
+    auto pct = [&](double q) {
+        const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(ticks.size() - 1));
+        std::nth_element(ticks.begin(), ticks.begin() + k, ticks.end());
+        return ticks[static_cast<std::size_t>(k)] * ns_per_tick;
+    };
+    out.p50 = pct(0.5);
+    out.p99 = pct(0.99);
+    out.p999 = pct(0.999);
+    out.overhead_ns = overhead * ns_per_tick;
+    out.resolution_ns = step == UINT64_MAX ? 0.0 : static_cast<double>(step) * ns_per_tick;
+#else
+    (void)det;
+    (void)events;
+#endif
+    return out;
+}
+
+Row bench_one(const std::string& input, const std::string& name, SensorSize sensor,
+              const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
+              Latency& clock) {
+    Row row;
+    row.input = input;
+    row.detector = name;
+    row.sensor = sensor;
+    row.file_events = file_events;
+    row.events = events.size();
+    std::vector<std::uint8_t> flags(events.size());
+    const double n = static_cast<double>(events.size());
+    for (int r = 0; r < o.repeat; ++r) {
+        AnyDetector any = make_detector(name, sensor);
+        row.memory = memory_bytes(any);
+        std::visit(
+            [&](auto& det) {
+                const auto t0 = Clock::now();
+                row.corners = detect(det, std::span<const Event>(events), flags);
+                const auto t1 = Clock::now();
+                row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / n);
+            },
+            any);
+    }
+    row.median = median_of(row.ns_per_event);
+    row.min = *std::min_element(row.ns_per_event.begin(), row.ns_per_event.end());
+    row.max = *std::max_element(row.ns_per_event.begin(), row.ns_per_event.end());
+    if (!o.no_latency) {
+        AnyDetector any = make_detector(name, sensor);
+        std::visit(
+            [&](auto& det) {
+                const Latency l = time_each_event(det, events);
+                row.p50 = l.p50;
+                row.p99 = l.p99;
+                row.p999 = l.p999;
+                clock = l;
+            },
+            any);
+    }
+    return row;
+}
+
+// ----------------------------------------------------------------- report
+
+std::string short_name(const std::string& path) {
+    // parent/name is enough to tell the real files apart (ecd-stppp/x/events.txt).
+    const auto slash = path.find_last_of('/');
+    if (slash == std::string::npos || slash == 0) return path;
+    const auto prev = path.find_last_of('/', slash - 1);
+    std::string s = path.substr(prev == std::string::npos ? 0 : prev + 1);
+    if (s.size() > 34) s = "..." + s.substr(s.size() - 31);
+    return s;
+}
+
+void print_table(const std::vector<Row>& rows, const std::vector<std::string>& detectors, bool latency) {
+    fmt::print("{:<34} {:<13} {:>10} {:>7} {:>7} {:>7} {:>8}", "input", "detector", "events", "median",
+               "min", "max", "Mev/s");
+    if (latency) fmt::print(" {:>7} {:>7} {:>7}", "p50", "p99", "p99.9");
+    fmt::print(" {:>11}\n", "memory [B]");
+    fmt::print("{:<34} {:<13} {:>10} {:>23} {:>8}", "", "", "", "ns/event", "max rate");
+    if (latency) fmt::print(" {:>23}", "latency ns/event");
+    fmt::print("\n");
+    auto line = [&](const std::string& in, const std::string& det, std::uint64_t ev, double med, double mn,
+                    double mx, double p50, double p99, double p999, std::size_t mem) {
+        fmt::print("{:<34} {:<13} {:>10} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.2f}", in, det, ev, med, mn, mx,
+                   med > 0 ? 1e3 / med : 0.0);
+        if (latency) fmt::print(" {:>7.0f} {:>7.0f} {:>7.0f}", p50, p99, p999);
+        fmt::print(" {:>11}\n", mem);
+    };
+    for (const Row& r : rows)
+        line(short_name(r.input), r.detector, r.events, r.median, r.min, r.max, r.p50, r.p99, r.p999, r.memory);
+    std::size_t files = 0;
+    for (const Row& r : rows) files += r.detector == detectors.front();
+    if (files < 2) return;
+    fmt::print("\nmedian over the {} inputs of the per-input figures (min: smallest min, max: largest max):\n",
+               files);
+    for (const std::string& d : detectors) {
+        std::vector<double> med, p50, p99, p999;
+        double mn = 1e300, mx = 0;
+        std::size_t mem = 0;
+        std::uint64_t events = 0;
+        for (const Row& r : rows) {
+            if (r.detector != d) continue;
+            events += r.events;
+            med.push_back(r.median);
+            p50.push_back(r.p50);
+            p99.push_back(r.p99);
+            p999.push_back(r.p999);
+            mn = std::min(mn, r.min);
+            mx = std::max(mx, r.max);
+            mem = std::max(mem, r.memory);
+        }
+        line("all inputs", d, events, median_of(med), mn, mx, median_of(p50), median_of(p99), median_of(p999), mem);
+    }
+}
+
+void write_json(const std::string& path, const std::vector<Row>& rows, const std::string& cpu,
+                const Latency& clock, const BenchOptions& o) {
+    nlohmann::json j;
+    j["cpu"] = cpu;
+    j["compiler"] = compiler();
+    j["build_type"] = EVCORNER_BUILD_TYPE;
+    j["build_flags"] = EVCORNER_BUILD_FLAGS;
+    j["repeat"] = o.repeat;
+    j["min_events"] = o.min_events;
+    j["latency_clock_overhead_ns"] = o.no_latency ? nlohmann::json(nullptr) : nlohmann::json(clock.overhead_ns);
+    j["latency_clock_resolution_ns"] = o.no_latency ? nlohmann::json(nullptr) : nlohmann::json(clock.resolution_ns);
+    j["results"] = nlohmann::json::array();
+    for (const Row& r : rows) {
+        nlohmann::json x;
+        x["input"] = r.input;
+        x["detector"] = r.detector;
+        x["width"] = r.sensor.width;
+        x["height"] = r.sensor.height;
+        x["file_events"] = r.file_events;
+        x["events"] = r.events;
+        x["corners"] = r.corners;
+        x["ns_per_event"] = r.ns_per_event;
+        x["ns_per_event_median"] = r.median;
+        x["ns_per_event_min"] = r.min;
+        x["ns_per_event_max"] = r.max;
+        x["max_event_rate_meps"] = r.median > 0 ? 1e3 / r.median : 0.0;
+        if (!o.no_latency) {
+            x["latency_ns_p50"] = r.p50;
+            x["latency_ns_p99"] = r.p99;
+            x["latency_ns_p999"] = r.p999;
+        }
+        x["memory_bytes"] = r.memory;
+        j["results"].push_back(std::move(x));
+    }
+    io::OutputFile out(path);
+    out.write(j.dump(2));
+    out.write("\n");
+    out.close();
+}
+
+std::vector<std::string> split_list(const std::string& s) {
+    std::vector<std::string> v;
+    std::stringstream in(s);
+    std::string item;
+    while (std::getline(in, item, ','))
+        if (!item.empty()) v.push_back(item);
+    return v;
+}
+
+void run_bench(const BenchOptions& o) {
+    const std::vector<std::string> detectors = split_list(o.detectors);
+    if (detectors.empty()) throw std::invalid_argument("-d: no detector named");
+    for (const auto& d : detectors) (void)make_detector(d, kDavis240);  // unknown names fail now
+
+    const std::string cpu = cpu_model();
+    fmt::print("evcorner bench: {} input(s), detectors {}, {} pass(es) each over >= {} events\n", o.inputs.size(),
+               o.detectors, o.repeat, o.min_events);
+    fmt::print("CPU      {}\n", cpu);
+    fmt::print("build    {} build, {}, flags: {}\n", EVCORNER_BUILD_TYPE, compiler(), EVCORNER_BUILD_FLAGS);
+    fmt::print("method   one thread; throughput: steady_clock around detect() over the replayed stream,\n"
+               "         fresh detector per pass; latency: rdtscp/lfence around each event, clock overhead\n"
+               "         subtracted (fenced, so an upper bound)\n\n");
+    std::fflush(stdout);
+
+    std::vector<Row> rows;
+    Latency clock;
+    for (const std::string& input : o.inputs) {
+        SensorSize sensor;
+        std::vector<Event> stream;
+        std::uint64_t file_events = 0;
+        {
+            const std::vector<Event> file = load(input, o, sensor);
+            file_events = file.size();
+            stream = replay(file, o.min_events);
+        }
+        if (stream.empty()) {
+            fmt::print(stderr, "evcorner bench: {}: no events, skipped\n", input);
+            continue;
+        }
+        for (const std::string& d : detectors) {
+            rows.push_back(bench_one(input, d, sensor, stream, file_events, o, clock));
+            std::fflush(stdout);
+            if (!o.quiet)
+                fmt::print(stderr, "  {} {}: {:.1f} ns/event\n", short_name(input), d, rows.back().median);
+        }
+    }
+    if (!o.quiet) fmt::print(stderr, "\n");
+    print_table(rows, detectors, !o.no_latency);
+    if (!o.no_latency)
+        fmt::print("\nlatency clock: overhead {:.1f} ns (subtracted), resolution {:.1f} ns\n", clock.overhead_ns,
+                   clock.resolution_ns);
+    if (!o.json.empty()) write_json(o.json, rows, cpu, clock, o);
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+    auto o = std::make_shared<BenchOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "bench",
+        "Benchmark the detectors on event files: the paper's Table 2 for this machine.\n"
+        "Each input is replayed (shifted in time per repetition) to at least --min-events\n"
+        "events; each detector runs --repeat times over it, one thread. Prints ns/event\n"
+        "(median, min, max), the maximum sustainable event rate, per-event latency\n"
+        "percentiles (p50, p99, p99.9), detector memory, the CPU model and build flags.");
+    cmd->add_option("FILE", o->inputs, "Event files (any format evcorner reads)")->required();
+    cmd->add_option("-d,--detectors", o->detectors, "Comma-separated detectors to run")->capture_default_str();
+    cmd->add_option("--repeat", o->repeat, "Timed passes per detector and input")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
+    cmd->add_option("--min-events", o->min_events, "Replay each input until it holds at least this many events")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
+    cmd->add_option("--json", o->json, "Also write every figure as JSON to this file (- = standard output)");
+    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
+    cmd->add_option("--size", o->size, "Sensor size WxH [default: the file's own, else 240x180]")
+        ->check([](const std::string& s) {
+            return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
+        });
+    cmd->add_flag("--no-latency", o->no_latency, "Skip the per-event latency pass");
+    cmd->add_flag("-q,--quiet", o->quiet, "No per-run progress lines on standard error");
+    cmd->footer(
+        "Examples:\n"
+        "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt\n"
+        "  evcorner bench recording.raw -d efast --repeat 9 --min-events 20000000 --json bench.json");
+    cmd->callback([o] { run_bench(*o); });
+}
+
+}  // namespace evcorner::cli
