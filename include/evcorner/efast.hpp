@@ -46,6 +46,9 @@ public:
                    centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
     }
 
+    /// Updates the SAE with `e` without classifying it (the halo of a parallel part).
+    void observe(const Event& e) noexcept { sae_.update(e); }
+
     [[nodiscard]] const Sae& sae() const noexcept { return sae_; }
     [[nodiscard]] SensorSize size() const noexcept { return sae_.size(); }
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }

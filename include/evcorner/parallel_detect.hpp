@@ -1,0 +1,169 @@
+#pragma once
+// Running a local detector on several threads with output identical to one thread.
+//
+// A detector is *local* with radius r when whether event e is a corner depends only on
+// the earlier events of e's polarity within r pixels of e (eFAST: r = 4, the radius-4
+// circle; Harris: half its window). Then the sensor splits into parts, each a polarity
+// set times a band of rows [y0, y1): the thread of a part keeps its own detector, feeds
+// it, in input order, every event of its polarities in rows [y0 - r, y1 + r) (the band
+// and its halo), and classifies only the events of its band. Each event is classified
+// by exactly one part, from a state identical to that of a single detector run over the
+// whole stream, so the flags are identical, in input order, for any number of threads.
+//
+// Parts: with an even thread count, polarities split first (no halo needed between
+// them), then rows; with an odd one, rows only. Band edges follow the distribution of
+// rows in the first batch, so that parts get similar numbers of events; they are fixed
+// from then on (each part's state only covers its band and halo).
+//
+// Threads, clocks and allocation stay outside the detectors: detect() below is the
+// batch loop of detector.hpp, run by each thread on its share.
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "evcorner/detector.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/sensor.hpp"
+
+namespace evcorner {
+
+/// A fixed set of threads that run one job together: run(job) calls job(w) for every
+/// worker w in 0..size() (w = 0 on the calling thread) and returns when all are done.
+class WorkerPool {
+public:
+    explicit WorkerPool(int threads);
+    ~WorkerPool();
+    WorkerPool(const WorkerPool&) = delete;
+    WorkerPool& operator=(const WorkerPool&) = delete;
+
+    [[nodiscard]] int size() const noexcept { return threads_; }
+    void run(const std::function<void(int)>& job);
+
+private:
+    struct State;
+    int threads_;
+    std::unique_ptr<State> state_;
+};
+
+/// One part of the sensor: the polarities it owns (bit p set) and its band of rows.
+struct DetectPart {
+    unsigned polarities = 3;
+    int y0 = 0;
+    int y1 = 0;
+};
+
+/// Splits `size` into `threads` parts, bands balanced on the rows of `sample`.
+std::vector<DetectPart> plan_parts(SensorSize size, int threads, std::span<const Event> sample);
+
+/// Feeds a detector only what it needs to see: the SAE update of a halo event. Detectors
+/// with an observe(e) method (update the state, classify nothing) get that; others run
+/// process(e) and the answer is dropped.
+template <class D>
+inline void observe(D& det, const Event& e) noexcept {
+    if constexpr (requires { det.observe(e); }) {
+        det.observe(e);
+    } else {
+        (void)det.process(e);
+    }
+}
+
+template <Detector D>
+class ParallelDetector {
+public:
+    /// `make()` builds one detector (one per part); `radius` is the detector's locality.
+    template <class Make>
+    ParallelDetector(SensorSize size, int threads, int radius, Make make)
+        : size_(size), radius_(radius), pool_(std::max(1, threads)) {
+        for (int i = 0; i < pool_.size(); ++i) detectors_.push_back(std::make_unique<D>(make()));
+        shares_.resize(static_cast<std::size_t>(pool_.size()));
+    }
+
+    [[nodiscard]] int threads() const noexcept { return pool_.size(); }
+    [[nodiscard]] std::span<const DetectPart> parts() const noexcept { return parts_; }
+
+    /// Like detect(det, events, is_corner) for a single detector, continuing the stream.
+    std::size_t detect(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
+        if (pool_.size() == 1) return evcorner::detect(*detectors_[0], events, is_corner);
+        if (parts_.empty()) parts_ = plan_parts(size_, pool_.size(), events);
+        std::size_t corners = 0;
+        for (std::size_t at = 0; at < events.size(); at += kChunk) {
+            const std::size_t n = std::min(kChunk, events.size() - at);
+            corners += detect_chunk(events.subspan(at, n), is_corner.subspan(at, n));
+        }
+        return corners;
+    }
+
+    /// Bytes of state over all parts.
+    template <class MemoryOf>
+    [[nodiscard]] std::size_t memory_bytes(MemoryOf memory_of) const {
+        std::size_t b = 0;
+        for (const auto& d : detectors_) b += memory_of(*d);
+        return b;
+    }
+
+private:
+    // Events per round of the threads: bounds the per-thread buffers (5 bytes an event).
+    static constexpr std::size_t kChunk = std::size_t{1} << 18;
+
+    std::size_t detect_chunk(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
+        const std::size_t n = events.size();
+        for (auto& s : shares_) {
+            s.own.resize(n);
+            s.seen.resize(n);
+        }
+        pool_.run([&](int w) { run_part(static_cast<std::size_t>(w), events); });
+        // Every event belongs to exactly one part: merge by OR, in input order.
+        std::size_t corners = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            std::uint8_t c = 0;
+            for (const auto& s : shares_) c |= s.own[i];
+            is_corner[i] = c;
+            corners += c;
+        }
+        return corners;
+    }
+
+    struct Share {
+        std::vector<std::uint8_t> own;   // 1 = corner; 0 for every event of other parts
+        std::vector<std::uint32_t> seen; // positions of the events this part must see
+    };
+
+    void run_part(std::size_t w, std::span<const Event> events) noexcept {
+        const DetectPart part = parts_[w];
+        Share& s = shares_[w];
+        D& det = *detectors_[w];
+        const int lo = part.y0 - radius_;
+        const int hi = part.y1 + radius_;
+        // Branch-free selection of the events to see (polarity and rows are data and
+        // would mispredict), then a loop in which only band edges branch.
+        std::size_t m = 0;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            const Event& e = events[i];
+            s.seen[m] = static_cast<std::uint32_t>(i);
+            m += ((part.polarities >> e.p) & 1u) & static_cast<unsigned>(e.y >= lo) & static_cast<unsigned>(e.y < hi);
+        }
+        std::fill(s.own.begin(), s.own.begin() + static_cast<std::ptrdiff_t>(events.size()), std::uint8_t{0});
+        for (std::size_t k = 0; k < m; ++k) {
+            const std::uint32_t i = s.seen[k];
+            const Event& e = events[i];
+            if (e.y >= part.y0 && e.y < part.y1)
+                s.own[i] = static_cast<std::uint8_t>(det.process(e));
+            else
+                observe(det, e);
+        }
+    }
+
+    SensorSize size_;
+    int radius_;
+    WorkerPool pool_;
+    std::vector<std::unique_ptr<D>> detectors_;
+    std::vector<DetectPart> parts_;
+    std::vector<Share> shares_;
+};
+
+}  // namespace evcorner

@@ -1,0 +1,119 @@
+// Parallel detection: identical flags, in input order, to one detector on one thread,
+// for 1..4 threads, on random HD streams and on the bundled sample.
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "evcorner/efast.hpp"
+#include "evcorner/harris.hpp"
+#include "evcorner/io/text_reader.hpp"
+#include "evcorner/parallel_detect.hpp"
+#include "test_util.hpp"
+
+namespace evcorner {
+namespace {
+
+// Blobs drifting over the sensor (edges and corners), uniform clutter, ties in time.
+std::vector<Event> random_stream(SensorSize s, std::size_t n, std::uint32_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::normal_distribution<double> spread(0.0, 4.0);
+    struct Blob {
+        double x, y, vx, vy;
+    };
+    std::vector<Blob> blobs(12);
+    for (auto& b : blobs) b = {unit(rng) * s.width, unit(rng) * s.height, 4 * (unit(rng) - 0.5), 4 * (unit(rng) - 0.5)};
+    std::vector<Event> ev;
+    std::int64_t t = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        t += static_cast<std::int64_t>(rng() % 3);
+        int x, y;
+        if (unit(rng) < 0.1) {
+            x = static_cast<int>(rng() % static_cast<unsigned>(s.width));
+            y = static_cast<int>(rng() % static_cast<unsigned>(s.height));
+        } else {
+            Blob& b = blobs[rng() % blobs.size()];
+            b.x += b.vx * 0.01;
+            b.y += b.vy * 0.01;
+            if (b.x < 0 || b.x >= s.width) b.vx = -b.vx;
+            if (b.y < 0 || b.y >= s.height) b.vy = -b.vy;
+            x = std::clamp(static_cast<int>(b.x + spread(rng)), 0, s.width - 1);
+            y = std::clamp(static_cast<int>(b.y + spread(rng)), 0, s.height - 1);
+        }
+        ev.push_back({t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
+                      static_cast<std::uint8_t>(rng() & 1)});
+    }
+    return ev;
+}
+
+template <class D, class Make>
+void expect_same_as_one_thread(const std::vector<Event>& events, SensorSize s, int radius, Make make,
+                               std::size_t batch, bool need_corners = true) {
+    D one = make();
+    std::vector<std::uint8_t> expected(events.size());
+    const std::size_t corners = detect(one, std::span<const Event>(events), expected);
+    if (need_corners) {
+        ASSERT_GT(corners, 0u);  // else the comparison is empty
+    }
+    for (int threads = 1; threads <= 4; ++threads) {
+        SCOPED_TRACE(threads);
+        ParallelDetector<D> par(s, threads, radius, make);
+        std::vector<std::uint8_t> got(events.size(), 7);
+        std::size_t c = 0;
+        // In batches, as evcorner detect reads them: the state carries over.
+        for (std::size_t at = 0; at < events.size(); at += batch) {
+            const std::size_t n = std::min(batch, events.size() - at);
+            c += par.detect(std::span<const Event>(events).subspan(at, n), std::span<std::uint8_t>(got).subspan(at, n));
+        }
+        EXPECT_EQ(c, corners);
+        for (std::size_t i = 0; i < events.size(); ++i) ASSERT_EQ(got[i], expected[i]) << "event " << i;
+    }
+}
+
+TEST(ParallelDetect, EFastRandomHdStreams) {
+    const SensorSize hd{1280, 720};
+    for (std::uint32_t seed = 1; seed <= 3; ++seed) {
+        SCOPED_TRACE(seed);
+        const auto events = random_stream(hd, 300000, seed);
+        expect_same_as_one_thread<EFast>(events, hd, kCircleMargin, [&] { return EFast(hd); }, 70000);
+    }
+}
+
+TEST(ParallelDetect, EFastSmallSensors) {
+    for (const SensorSize s : {SensorSize{9, 9}, SensorSize{17, 11}, SensorSize{64, 48}}) {
+        const auto events = random_stream(s, 40000, 11);
+        expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [&] { return EFast(s); }, 4096,
+                                         /*need_corners=*/s.width > 32);
+    }
+}
+
+TEST(ParallelDetect, EFastBundledSample) {
+    const auto events = io::read_text_file((test::bundled_data() / "ecd/shapes_translation/events.txt").string());
+    expect_same_as_one_thread<EFast>(events, kDavis240, kCircleMargin, [] { return EFast(kDavis240); }, 1 << 16);
+}
+
+TEST(ParallelDetect, HarrisRandomHdStream) {
+    const SensorSize hd{1280, 720};
+    const auto events = random_stream(hd, 40000, 5);
+    expect_same_as_one_thread<Harris>(events, hd, HarrisParams{}.window / 2, [&] { return Harris(hd); }, 9000);
+}
+
+TEST(ParallelDetect, PartsCoverTheSensorOnce) {
+    const SensorSize hd{1280, 720};
+    const auto events = random_stream(hd, 20000, 3);
+    for (int threads = 1; threads <= 8; ++threads) {
+        const auto parts = plan_parts(hd, threads, events);
+        ASSERT_EQ(static_cast<int>(parts.size()), threads);
+        for (int p = 0; p < 2; ++p)
+            for (int y = 0; y < hd.height; ++y) {
+                int owners = 0;
+                for (const auto& part : parts) owners += ((part.polarities >> p) & 1u) && y >= part.y0 && y < part.y1;
+                ASSERT_EQ(owners, 1) << threads << " threads, polarity " << p << ", row " << y;
+            }
+    }
+}
+
+}  // namespace
+}  // namespace evcorner
