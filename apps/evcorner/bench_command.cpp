@@ -13,6 +13,8 @@
 //    section (the clock's own overhead) is measured first and subtracted; it is printed.
 //    The timed pass runs slower than the throughput passes (the fences stop events from
 //    overlapping), so its percentiles bound a single event's latency from above.
+//  - --threads 1,2,...: efast and harris also run split over that many threads
+//    (parallel_detect.hpp), timed the same way; thread start-up is outside the timing.
 // Data flows one way: the timing wraps the loop; the detectors know nothing of it.
 
 #include <algorithm>
@@ -37,6 +39,7 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
+#include "evcorner/parallel_detect.hpp"
 
 #ifndef EVCORNER_BUILD_TYPE
 #define EVCORNER_BUILD_TYPE "unknown"
@@ -61,6 +64,7 @@ struct BenchOptions {
     std::string csv_columns;
     std::string time_unit = "us";
     std::string size;
+    std::string threads = "1";
     bool no_latency = false;
     bool quiet = false;
 };
@@ -68,6 +72,7 @@ struct BenchOptions {
 struct Row {
     std::string input;
     std::string detector;
+    int threads = 1;
     SensorSize sensor;
     std::uint64_t file_events = 0;
     std::uint64_t events = 0;  // after replay
@@ -271,6 +276,44 @@ Row bench_one(const std::string& input, const std::string& name, SensorSize sens
     return row;
 }
 
+/// Throughput passes with the sensor split over `threads` threads (parallel_detect.hpp).
+Row bench_parallel(const std::string& input, const std::string& name, int threads, SensorSize sensor,
+                   const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o) {
+    Row row;
+    row.input = input;
+    row.detector = name;
+    row.threads = threads;
+    row.sensor = sensor;
+    row.file_events = file_events;
+    row.events = events.size();
+    std::vector<std::uint8_t> flags(events.size());
+    const double n = static_cast<double>(events.size());
+    auto passes = [&](auto make_par) {
+        for (int r = 0; r < o.repeat; ++r) {
+            auto par = make_par();  // threads started outside the timing
+            const auto t0 = Clock::now();
+            row.corners = par->detect(std::span<const Event>(events), flags);
+            const auto t1 = Clock::now();
+            row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / n);
+            row.memory = par->memory_bytes([](const auto& d) { return d.memory_bytes(); });
+        }
+    };
+    if (name == "efast") {
+        passes([&] { return std::make_unique<ParallelDetector<EFast>>(sensor, threads, kCircleMargin, [&] { return EFast(sensor); }); });
+    } else if (name == "harris") {
+        passes([&] {
+            return std::make_unique<ParallelDetector<Harris>>(sensor, threads, HarrisParams{}.window / 2,
+                                                              [&] { return Harris(sensor); });
+        });
+    } else {
+        throw std::invalid_argument("--threads: detector '" + name + "' is not local (efast and harris are)");
+    }
+    row.median = median_of(row.ns_per_event);
+    row.min = *std::min_element(row.ns_per_event.begin(), row.ns_per_event.end());
+    row.max = *std::max_element(row.ns_per_event.begin(), row.ns_per_event.end());
+    return row;
+}
+
 // ----------------------------------------------------------------- report
 
 std::string short_name(const std::string& path) {
@@ -283,35 +326,40 @@ std::string short_name(const std::string& path) {
     return s;
 }
 
-void print_table(const std::vector<Row>& rows, const std::vector<std::string>& detectors, bool latency) {
-    fmt::print("{:<34} {:<13} {:>10} {:>7} {:>7} {:>7} {:>8}", "input", "detector", "events", "median",
+void print_table(const std::vector<Row>& rows, const std::vector<std::string>& detectors,
+                 const std::vector<int>& thread_counts, bool latency) {
+    fmt::print("{:<34} {:<13} {:>3} {:>10} {:>7} {:>7} {:>7} {:>8}", "input", "detector", "thr", "events", "median",
                "min", "max", "Mev/s");
     if (latency) fmt::print(" {:>7} {:>7} {:>7}", "p50", "p99", "p99.9");
     fmt::print(" {:>11}\n", "memory [B]");
-    fmt::print("{:<34} {:<13} {:>10} {:>23} {:>8}", "", "", "", "ns/event", "max rate");
+    fmt::print("{:<34} {:<13} {:>3} {:>10} {:>23} {:>8}", "", "", "", "", "ns/event", "max rate");
     if (latency) fmt::print(" {:>23}", "latency ns/event");
     fmt::print("\n");
-    auto line = [&](const std::string& in, const std::string& det, std::uint64_t ev, double med, double mn,
+    auto line = [&](const std::string& in, const std::string& det, int thr, std::uint64_t ev, double med, double mn,
                     double mx, double p50, double p99, double p999, std::size_t mem) {
-        fmt::print("{:<34} {:<13} {:>10} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.2f}", in, det, ev, med, mn, mx,
+        fmt::print("{:<34} {:<13} {:>3} {:>10} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.2f}", in, det, thr, ev, med, mn, mx,
                    med > 0 ? 1e3 / med : 0.0);
-        if (latency) fmt::print(" {:>7.0f} {:>7.0f} {:>7.0f}", p50, p99, p999);
+        if (latency && p50 > 0)
+            fmt::print(" {:>7.0f} {:>7.0f} {:>7.0f}", p50, p99, p999);
+        else if (latency)
+            fmt::print(" {:>7} {:>7} {:>7}", "-", "-", "-");
         fmt::print(" {:>11}\n", mem);
     };
     for (const Row& r : rows)
-        line(short_name(r.input), r.detector, r.events, r.median, r.min, r.max, r.p50, r.p99, r.p999, r.memory);
+        line(short_name(r.input), r.detector, r.threads, r.events, r.median, r.min, r.max, r.p50, r.p99, r.p999, r.memory);
     std::size_t files = 0;
-    for (const Row& r : rows) files += r.detector == detectors.front();
+    for (const Row& r : rows) files += r.detector == detectors.front() && r.threads == thread_counts.front();
     if (files < 2) return;
     fmt::print("\nmedian over the {} inputs of the per-input figures (min: smallest min, max: largest max):\n",
                files);
-    for (const std::string& d : detectors) {
+    for (const std::string& d : detectors)
+    for (const int thr : thread_counts) {
         std::vector<double> med, p50, p99, p999;
         double mn = 1e300, mx = 0;
         std::size_t mem = 0;
         std::uint64_t events = 0;
         for (const Row& r : rows) {
-            if (r.detector != d) continue;
+            if (r.detector != d || r.threads != thr) continue;
             events += r.events;
             med.push_back(r.median);
             p50.push_back(r.p50);
@@ -321,7 +369,8 @@ void print_table(const std::vector<Row>& rows, const std::vector<std::string>& d
             mx = std::max(mx, r.max);
             mem = std::max(mem, r.memory);
         }
-        line("all inputs", d, events, median_of(med), mn, mx, median_of(p50), median_of(p99), median_of(p999), mem);
+        if (med.empty()) continue;
+        line("all inputs", d, thr, events, median_of(med), mn, mx, median_of(p50), median_of(p99), median_of(p999), mem);
     }
 }
 
@@ -341,6 +390,7 @@ void write_json(const std::string& path, const std::vector<Row>& rows, const std
         nlohmann::json x;
         x["input"] = r.input;
         x["detector"] = r.detector;
+        x["threads"] = r.threads;
         x["width"] = r.sensor.width;
         x["height"] = r.sensor.height;
         x["file_events"] = r.file_events;
@@ -351,7 +401,7 @@ void write_json(const std::string& path, const std::vector<Row>& rows, const std
         x["ns_per_event_min"] = r.min;
         x["ns_per_event_max"] = r.max;
         x["max_event_rate_meps"] = r.median > 0 ? 1e3 / r.median : 0.0;
-        if (!o.no_latency) {
+        if (!o.no_latency && r.p50 > 0) {
             x["latency_ns_p50"] = r.p50;
             x["latency_ns_p99"] = r.p99;
             x["latency_ns_p999"] = r.p999;
@@ -378,6 +428,13 @@ void run_bench(const BenchOptions& o) {
     const std::vector<std::string> detectors = split_list(o.detectors);
     if (detectors.empty()) throw std::invalid_argument("-d: no detector named");
     for (const auto& d : detectors) (void)make_detector(d, kDavis240);  // unknown names fail now
+    std::vector<int> thread_counts;
+    for (const auto& t : split_list(o.threads)) {
+        const int k = std::atoi(t.c_str());
+        if (k < 1 || k > 256) throw std::invalid_argument("--threads: expected counts 1..256, got '" + t + "'");
+        thread_counts.push_back(k);
+    }
+    if (thread_counts.empty()) thread_counts.push_back(1);
 
     const std::string cpu = cpu_model();
     fmt::print("evcorner bench: {} input(s), detectors {}, {} pass(es) each over >= {} events\n", o.inputs.size(),
@@ -404,15 +461,18 @@ void run_bench(const BenchOptions& o) {
             fmt::print(stderr, "evcorner bench: {}: no events, skipped\n", input);
             continue;
         }
-        for (const std::string& d : detectors) {
-            rows.push_back(bench_one(input, d, sensor, stream, file_events, o, clock));
-            std::fflush(stdout);
-            if (!o.quiet)
-                fmt::print(stderr, "  {} {}: {:.1f} ns/event\n", short_name(input), d, rows.back().median);
-        }
+        for (const std::string& d : detectors)
+            for (const int thr : thread_counts) {
+                if (thr > 1 && d != "efast" && d != "harris") continue;  // not local: one thread only
+                rows.push_back(thr == 1 ? bench_one(input, d, sensor, stream, file_events, o, clock)
+                                        : bench_parallel(input, d, thr, sensor, stream, file_events, o));
+                std::fflush(stdout);
+                if (!o.quiet)
+                    fmt::print(stderr, "  {} {} x{}: {:.1f} ns/event\n", short_name(input), d, thr, rows.back().median);
+            }
     }
     if (!o.quiet) fmt::print(stderr, "\n");
-    print_table(rows, detectors, !o.no_latency);
+    print_table(rows, detectors, thread_counts, !o.no_latency);
     if (!o.no_latency)
         fmt::print("\nlatency clock: overhead {:.1f} ns (subtracted), resolution {:.1f} ns\n", clock.overhead_ns,
                    clock.resolution_ns);
@@ -444,12 +504,17 @@ void add_bench_command(CLI::App& app) {
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
         });
+    cmd->add_option("--threads", o->threads,
+                    "Comma-separated thread counts, e.g. 1,2: efast and harris also run split over that many "
+                    "threads (parallel_detect.hpp; no latency pass); others run on one")
+        ->capture_default_str();
     cmd->add_flag("--no-latency", o->no_latency, "Skip the per-event latency pass");
     cmd->add_flag("-q,--quiet", o->quiet, "No per-run progress lines on standard error");
     cmd->footer(
         "Examples:\n"
         "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt\n"
-        "  evcorner bench recording.raw -d efast --repeat 9 --min-events 20000000 --json bench.json");
+        "  evcorner bench recording.raw -d efast --repeat 9 --min-events 20000000 --json bench.json\n"
+        "  evcorner bench hd.raw -d efast --threads 1,2          # multi-core speed-up");
     cmd->callback([o] { run_bench(*o); });
 }
 

@@ -20,6 +20,7 @@
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/text_writer.hpp"
+#include "evcorner/parallel_detect.hpp"
 #include "evcorner/scored_detector.hpp"
 #include "progress.hpp"
 
@@ -46,6 +47,7 @@ struct DetectOptions {
     DetectorParams params;
     bool quiet = false;
     bool no_progress = false;
+    int threads = 1;
 };
 
 struct Totals {
@@ -127,6 +129,11 @@ void run_detect(const DetectOptions& o) {
     if (o.with_score && !has_score(detector))
         throw std::invalid_argument("--with-score: detector '" + o.detector +
                                     "' has no score (harris and harris-global have one)");
+    if (o.threads > 1 && o.detector != "efast" && o.detector != "harris")
+        throw std::invalid_argument("--threads: detector '" + o.detector +
+                                    "' is not local (efast and harris split the sensor; harris-global cannot)");
+    if (o.threads > 1 && o.with_score)
+        throw std::invalid_argument("--threads: --with-score needs one thread");
     std::string to = o.to;
     if (to == "auto") {
         to = io::output_format_for(o.output);
@@ -160,40 +167,57 @@ void run_detect(const DetectOptions& o) {
         if (corners_out) corners_out->close();
         if (mask_out) mask_out->close();
     };
+    // One batch: read, detect (timed), write. Returns false at the end of the input.
+    auto step = [&](auto&& detect_batch) {
+        const std::size_t n = reader.read(events);
+        const auto skips = reader.skipped_in_batch();
+        if (n == 0 && skips.empty()) return false;
+        const auto t0 = Clock::now();
+        const std::size_t c = detect_batch(std::span<const Event>(events.data(), n));
+        totals.detect_s += std::chrono::duration<double>(Clock::now() - t0).count();
+        totals.events += n;
+        totals.corners += c;
+        if (scored_out) {
+            for (std::size_t i = 0; i < n; ++i)
+                if (flags[i]) scored_out->write(events[i], scores[i]);
+        } else {
+            corners.clear();
+            for (std::size_t i = 0; i < n; ++i)
+                if (flags[i]) corners.push_back(events[i]);
+            corners_out->write(corners);
+        }
+        if (mask_out) write_mask(*mask_out, flags, n, skips);
+        progress.update(reader.bytes_consumed(), totals.events);
+        return true;
+    };
     try {
-        std::visit(
-            [&](auto& det) {
-                for (;;) {
-                    const std::size_t n = reader.read(events);
-                    const auto skips = reader.skipped_in_batch();
-                    if (n == 0 && skips.empty()) break;
-                    const auto t0 = Clock::now();
-                    std::size_t c = 0;
-                    if constexpr (ScoredDetector<std::decay_t<decltype(det)>>) {
-                        if (o.with_score)
-                            c = detect(det, std::span<const Event>(events.data(), n), flags, scores);
-                        else
-                            c = detect(det, std::span<const Event>(events.data(), n), flags);
-                    } else {
-                        c = detect(det, std::span<const Event>(events.data(), n), flags);
-                    }
-                    totals.detect_s += std::chrono::duration<double>(Clock::now() - t0).count();
-                    totals.events += n;
-                    totals.corners += c;
-                    if (scored_out) {
-                        for (std::size_t i = 0; i < n; ++i)
-                            if (flags[i]) scored_out->write(events[i], scores[i]);
-                    } else {
-                        corners.clear();
-                        for (std::size_t i = 0; i < n; ++i)
-                            if (flags[i]) corners.push_back(events[i]);
-                        corners_out->write(corners);
-                    }
-                    if (mask_out) write_mask(*mask_out, flags, n, skips);
-                    progress.update(reader.bytes_consumed(), totals.events);
+        if (o.threads > 1) {
+            // Local detectors only: each thread owns a part of the sensor (parallel_detect.hpp).
+            auto run_parallel = [&](auto& par) {
+                while (step([&](std::span<const Event> batch) { return par.detect(batch, flags); })) {
                 }
-            },
-            detector);
+            };
+            if (o.detector == "efast") {
+                ParallelDetector<EFast> par(size, o.threads, kCircleMargin, [&] { return EFast(size); });
+                run_parallel(par);
+            } else {
+                ParallelDetector<Harris> par(size, o.threads, o.params.harris.window / 2,
+                                             [&] { return Harris(size, o.params.harris); });
+                run_parallel(par);
+            }
+        } else {
+            std::visit(
+                [&](auto& det) {
+                    while (step([&](std::span<const Event> batch) {
+                        if constexpr (ScoredDetector<std::decay_t<decltype(det)>>) {
+                            if (o.with_score) return detect(det, batch, flags, scores);
+                        }
+                        return detect(det, batch, flags);
+                    })) {
+                    }
+                },
+                detector);
+        }
     } catch (const InputError&) {
         progress.finish();
         finish_outputs();
@@ -272,6 +296,11 @@ void add_detect_command(CLI::App& app) {
     cmd->add_option("--harris-k", o->params.harris.k, "Harris (both): k in H = det - k trace^2 [default: 0.04]");
     cmd->add_option("--harris-threshold", o->params.harris.threshold,
                     "Harris (both): corner iff score > threshold [default: 8]");
+    cmd->add_option("-j,--threads", o->threads,
+                    "Detection threads (efast, harris): the sensor splits by polarity and bands of rows "
+                    "with a halo of the detector's radius; output identical to one thread, same order")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 256));
     cmd->add_flag("--skip-invalid", o->skip_invalid,
                   "Skip events outside the sensor (counted in the summary) instead of failing");
     cmd->add_flag("-q,--quiet", o->quiet, "No summary and no progress bar");
@@ -283,6 +312,7 @@ void add_detect_command(CLI::App& app) {
         "  evcorner detect events.txt --mask is_corner.txt --summary-json summary.json > corners.txt\n"
         "  evcorner detect events.txt -d harris --with-score | head\n"
         "  evcorner detect events.txt -d harris-global --harris-n 2000\n"
+        "  evcorner detect hd_recording.raw --threads 2 -o corners.npy\n"
         "  cat events.txt | evcorner detect - --size 346x260 | head");
     cmd->callback([o] {
         // --harris-window, -k and -threshold apply to both Harris detectors.

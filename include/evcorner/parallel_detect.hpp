@@ -107,30 +107,38 @@ public:
     }
 
 private:
-    // Events per round of the threads: bounds the per-thread buffers (5 bytes an event).
+    // Events per round of the threads: bounds the per-thread buffers (8 bytes an event).
     static constexpr std::size_t kChunk = std::size_t{1} << 18;
 
     std::size_t detect_chunk(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
         const std::size_t n = events.size();
-        for (auto& s : shares_) {
-            s.own.resize(n);
-            s.seen.resize(n);
+        for (auto& sh : shares_) {
+            sh.seen.resize(n);
+            sh.corners.resize(n);
         }
-        pool_.run([&](int w) { run_part(static_cast<std::size_t>(w), events); });
-        // Every event belongs to exactly one part: merge by OR, in input order.
+        pool_.run([&](int w) {
+            // Each thread clears its slice of the output, then runs its part.
+            const std::size_t parts = shares_.size();
+            const std::size_t from = n * static_cast<std::size_t>(w) / parts;
+            const std::size_t to = n * (static_cast<std::size_t>(w) + 1) / parts;
+            std::fill(is_corner.begin() + static_cast<std::ptrdiff_t>(from),
+                      is_corner.begin() + static_cast<std::ptrdiff_t>(to), std::uint8_t{0});
+            run_part(static_cast<std::size_t>(w), events);
+        });
+        // Corners are sparse: set them here rather than have threads write bytes that
+        // share cache lines. Each event belongs to one part, so the order is the input's.
         std::size_t corners = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            std::uint8_t c = 0;
-            for (const auto& s : shares_) c |= s.own[i];
-            is_corner[i] = c;
-            corners += c;
+        for (const auto& sh : shares_) {
+            for (std::size_t k = 0; k < sh.found; ++k) is_corner[sh.corners[k]] = 1;
+            corners += sh.found;
         }
         return corners;
     }
 
     struct Share {
-        std::vector<std::uint8_t> own;   // 1 = corner; 0 for every event of other parts
-        std::vector<std::uint32_t> seen; // positions of the events this part must see
+        std::vector<std::uint32_t> seen;     // positions of the events this part must see
+        std::vector<std::uint32_t> corners;  // positions of the corners it found
+        std::size_t found = 0;
     };
 
     void run_part(std::size_t w, std::span<const Event> events) noexcept {
@@ -147,15 +155,18 @@ private:
             s.seen[m] = static_cast<std::uint32_t>(i);
             m += ((part.polarities >> e.p) & 1u) & static_cast<unsigned>(e.y >= lo) & static_cast<unsigned>(e.y < hi);
         }
-        std::fill(s.own.begin(), s.own.begin() + static_cast<std::ptrdiff_t>(events.size()), std::uint8_t{0});
+        std::size_t found = 0;
         for (std::size_t k = 0; k < m; ++k) {
             const std::uint32_t i = s.seen[k];
             const Event& e = events[i];
-            if (e.y >= part.y0 && e.y < part.y1)
-                s.own[i] = static_cast<std::uint8_t>(det.process(e));
-            else
+            if (e.y >= part.y0 && e.y < part.y1) {
+                s.corners[found] = i;
+                found += det.process(e);
+            } else {
                 observe(det, e);
+            }
         }
+        s.found = found;
     }
 
     SensorSize size_;

@@ -1,0 +1,98 @@
+// evcorner bench and evcorner detect --threads as a user runs them.
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "test_util.hpp"
+
+namespace evcorner {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+    int status;
+    std::string out;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class CliBench : public ::testing::Test {
+protected:
+    fs::path dir_;
+    fs::path sample_ = test::bundled_data() / "ecd/shapes_translation/events.txt";
+
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               (std::string("evcorner-cli-bench-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    Result run(const std::string& args) {
+        const std::string cmd = "cd '" + dir_.string() + "' && '" EVCORNER_CLI "' " + args +
+                                " </dev/null >out.stdout 2>out.stderr";
+        const int raw = std::system(cmd.c_str());
+        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir_ / "out.stdout"), slurp(dir_ / "out.stderr")};
+    }
+};
+
+TEST_F(CliBench, PrintsTheTableAndWritesJson) {
+    const Result r = run("bench '" + sample_.string() +
+                         "' --min-events 100000 --repeat 2 --threads 1,2 --json b.json -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const char* what : {"CPU", "build", "efast", "harris-global", "p99.9", "Mev/s", "memory"})
+        EXPECT_NE(r.out.find(what), std::string::npos) << what << " missing from:\n" << r.out;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "b.json"));
+    EXPECT_TRUE(j.contains("cpu"));
+    EXPECT_TRUE(j.contains("build_flags"));
+    // efast and harris at 1 and 2 threads, harris-global at 1.
+    ASSERT_EQ(j["results"].size(), 5u);
+    for (const auto& x : j["results"]) {
+        EXPECT_GE(x["events"].get<std::uint64_t>(), 100000u);
+        EXPECT_EQ(x["ns_per_event"].size(), 2u);
+        EXPECT_GT(x["ns_per_event_median"].get<double>(), 0.0);
+        EXPECT_GT(x["memory_bytes"].get<std::uint64_t>(), 0u);
+    }
+    // The replayed stream gives the same corners on 1 and 2 threads.
+    EXPECT_EQ(j["results"][0]["corners"], j["results"][1]["corners"]);
+}
+
+TEST_F(CliBench, UnknownDetectorIsAUsageError) {
+    const Result r = run("bench '" + sample_.string() + "' -d nope --min-events 10");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("nope"), std::string::npos) << r.err;
+}
+
+TEST_F(CliBench, DetectThreadsGivesIdenticalOutputs) {
+    ASSERT_EQ(run("detect '" + sample_.string() + "' -o one.txt --mask one.mask -q").status, 0);
+    for (const char* j : {"2", "3", "4"}) {
+        const Result r = run("detect '" + sample_.string() + "' --threads " + j + " -o many.txt --mask many.mask -q");
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(slurp(dir_ / "many.txt"), slurp(dir_ / "one.txt")) << j << " threads";
+        EXPECT_EQ(slurp(dir_ / "many.mask"), slurp(dir_ / "one.mask")) << j << " threads";
+    }
+}
+
+TEST_F(CliBench, DetectThreadsRefusesAGlobalDetector) {
+    const Result r = run("detect '" + sample_.string() + "' -d harris-global --threads 2 -q");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--threads"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace evcorner
