@@ -19,6 +19,11 @@
 #include <cstdint>
 #include <utility>
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define EVCORNER_HAVE_AVX2_SEARCH 1
+#endif
+
 namespace evcorner {
 
 namespace detail {
@@ -126,13 +131,53 @@ template <int N, int Lmin, int Lmax>
     return fires;
 }
 
+/// How circle_fires() finds one newest pixel of t[0..N): the portable way, a tournament.
+// newest() also completes the second copy t[N..2N) of t[0..N).
+struct ScalarSearch {
+    template <int N>
+    static int newest(std::int64_t* t) noexcept {
+#pragma GCC unroll 32
+        for (int k = 0; k < N; ++k) t[k + N] = t[k];
+        return detail::newest_of<0, N>(t).k;
+    }
+};
+
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+/// The same with AVX2: the maximum of the circle by four-wide compares, then the first
+/// lane equal to it. Only for code compiled for AVX2 (efast.cpp picks it at run time
+/// after checking the CPU; the function that inlines it carries target("avx2")).
+struct Avx2Search {
+    [[gnu::target("avx2"), gnu::always_inline]] static inline __m256i max(__m256i a, __m256i b) noexcept {
+        return _mm256_blendv_epi8(b, a, _mm256_cmpgt_epi64(a, b));
+    }
+    template <int N>
+    [[gnu::target("avx2")]] static int newest(std::int64_t* t) noexcept {
+        static_assert(N % 4 == 0);
+        __m256i v[N / 4];
+        for (int i = 0; i < N / 4; ++i) {
+            v[i] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 4 * i));
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(t + N + 4 * i), v[i]);
+        }
+        __m256i m = v[0];
+        for (int i = 1; i < N / 4; ++i) m = max(m, v[i]);
+        m = max(m, _mm256_permute4x64_epi64(m, 0x4E));  // swap the 128-bit halves
+        m = max(m, _mm256_shuffle_epi32(m, 0x4E));      // swap the 64-bit lanes
+        unsigned mask = 0;
+        for (int i = 0; i < N / 4; ++i)
+            mask |= static_cast<unsigned>(_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(v[i], m))))
+                    << (4 * i);
+        return __builtin_ctz(mask);
+    }
+};
+#endif
+
 /// Gathers the circle around `centre` (pixel k at centre[offset(k)]) and runs the test.
-template <int N, int Lmin, int Lmax, class Offset>
+template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
 [[nodiscard]] inline bool circle_fires(const std::int64_t* centre, Offset offset) noexcept {
     std::int64_t t[2 * N];
 #pragma GCC unroll 32
-    for (int k = 0; k < N; ++k) t[k] = t[k + N] = centre[offset(k)];
-    const int newest = detail::newest_of<0, N>(t).k;
+    for (int k = 0; k < N; ++k) t[k] = centre[offset(k)];
+    const int newest = Search::template newest<N>(t);
     return arc_fires_from<N, Lmin, Lmax>(t, newest);
 }
 

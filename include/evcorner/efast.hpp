@@ -10,6 +10,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
@@ -29,33 +30,71 @@ public:
 
     /// Updates the SAE with `e` and answers whether `e` is a corner event.
     /// `e` must lie on the sensor (readers validate).
-    bool process(const Event& e) noexcept {
-        sae_.update(e);
-        const SensorSize s = sae_.size();
-        if (e.x < kCircleMargin || e.x >= s.width - kCircleMargin || e.y < kCircleMargin ||
-            e.y >= s.height - kCircleMargin)
-            return false;
-        const std::int64_t* centre =
-            sae_.plane(e.p) + static_cast<std::ptrdiff_t>(e.y) * s.width + e.x;
-        // Offsets from compile-time circle coordinates: the loads address rows
-        // centre + dy * width with constant column offsets.
-        const std::ptrdiff_t w = s.width;
-        return circle_fires<kCircle3.size(), kArc3Min, kArc3Max>(
-                   centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }) &&
-               circle_fires<kCircle4.size(), kArc4Min, kArc4Max>(
-                   centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
+    bool process(const Event& e) noexcept { return process_with<ScalarSearch>(e); }
+
+    /// process() with a chosen way of finding a circle's newest pixel (arc_test.hpp).
+    template <class Search>
+    bool process_with(const Event& e) noexcept {
+        return View::make(sae_).template process<Search>(e);
     }
 
-    /// Updates the SAE with `e` without classifying it (the halo of a parallel part).
-    void observe(const Event& e) noexcept { sae_.update(e); }
+    /// detect() over a span with a chosen search. The sensor geometry and plane pointers
+    /// are held in locals for the whole loop: stores of the one-byte flags may alias
+    /// anything, so members would be reloaded (and offsets recomputed) every event.
+    template <class Search>
+    std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+        const View v = View::make(sae_);
+        std::size_t corners = 0;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            const bool c = v.template process<Search>(events[i]);
+            is_corner[i] = static_cast<std::uint8_t>(c);
+            corners += c;
+        }
+        return corners;
+    }
 
     [[nodiscard]] const Sae& sae() const noexcept { return sae_; }
     [[nodiscard]] SensorSize size() const noexcept { return sae_.size(); }
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
 
 private:
+    // The per-event path on plain values: planes, width, height.
+    struct View {
+        std::int64_t* plane[2];
+        std::ptrdiff_t width;
+        int height;
+
+        static View make(Sae& sae) noexcept {
+            return {{sae.plane(0), sae.plane(1)}, sae.size().width, sae.size().height};
+        }
+
+        template <class Search>
+        bool process(const Event& e) const noexcept {
+            std::int64_t* const centre = plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x;
+            *centre = e.t;  // the SAE update, border events included
+            if (e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
+                e.y >= height - kCircleMargin)
+                return false;
+            // Offsets from compile-time circle coordinates: the loads address rows
+            // centre + dy * width with constant column offsets.
+            const std::ptrdiff_t w = width;
+            return circle_fires<kCircle3.size(), kArc3Min, kArc3Max, Search>(
+                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }) &&
+                   circle_fires<kCircle4.size(), kArc4Min, kArc4Max, Search>(
+                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
+        }
+    };
+
     Sae sae_;
 };
 static_assert(Detector<EFast>);
+
+/// detect() for eFAST: the same flags, with the fastest code this CPU runs (AVX2 where
+/// the CPU has it, else portable), chosen once per process. Overload resolution picks
+/// it over the generic detect() of detector.hpp.
+std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+
+/// The code path detect(EFast&, ...) takes on this CPU: "avx2" or "portable".
+const char* efast_code_path() noexcept;
 
 }  // namespace evcorner

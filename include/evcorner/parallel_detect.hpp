@@ -6,7 +6,7 @@
 // circle; Harris: half its window). Then the sensor splits into parts, each a polarity
 // set times a band of rows [y0, y1): the thread of a part keeps its own detector, feeds
 // it, in input order, every event of its polarities in rows [y0 - r, y1 + r) (the band
-// and its halo), and classifies only the events of its band. Each event is classified
+// and its halo), and keeps its answers only for the events of its band. Each event is classified
 // by exactly one part, from a state identical to that of a single detector run over the
 // whole stream, so the flags are identical, in input order, for any number of threads.
 //
@@ -60,17 +60,14 @@ struct DetectPart {
 /// Splits `size` into `threads` parts, bands balanced on the rows of `sample`.
 std::vector<DetectPart> plan_parts(SensorSize size, int threads, std::span<const Event> sample);
 
-/// Feeds a detector only what it needs to see: the SAE update of a halo event. Detectors
-/// with an observe(e) method (update the state, classify nothing) get that; others run
-/// process(e) and the answer is dropped.
+namespace detail {
+// The detector's batch loop: an unqualified call, so that argument-dependent lookup
+// finds a detector's own overload (eFAST's, in efast.hpp) over the generic one.
 template <class D>
-inline void observe(D& det, const Event& e) noexcept {
-    if constexpr (requires { det.observe(e); }) {
-        det.observe(e);
-    } else {
-        (void)det.process(e);
-    }
+std::size_t run_batch(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    return detect(det, events, is_corner);
 }
+}  // namespace detail
 
 template <Detector D>
 class ParallelDetector {
@@ -88,7 +85,7 @@ public:
 
     /// Like detect(det, events, is_corner) for a single detector, continuing the stream.
     std::size_t detect(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
-        if (pool_.size() == 1) return evcorner::detect(*detectors_[0], events, is_corner);
+        if (pool_.size() == 1) return detail::run_batch(*detectors_[0], events, is_corner);
         if (parts_.empty()) parts_ = plan_parts(size_, pool_.size(), events);
         std::size_t corners = 0;
         for (std::size_t at = 0; at < events.size(); at += kChunk) {
@@ -107,13 +104,15 @@ public:
     }
 
 private:
-    // Events per round of the threads: bounds the per-thread buffers (8 bytes an event).
-    static constexpr std::size_t kChunk = std::size_t{1} << 18;
+    // Events per round of the threads: bounds the per-thread buffers (25 bytes an event).
+    static constexpr std::size_t kChunk = std::size_t{1} << 16;
 
     std::size_t detect_chunk(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
         const std::size_t n = events.size();
         for (auto& sh : shares_) {
             sh.seen.resize(n);
+            sh.events.resize(n);
+            sh.flags.resize(n);
             sh.corners.resize(n);
         }
         pool_.run([&](int w) {
@@ -137,34 +136,35 @@ private:
 
     struct Share {
         std::vector<std::uint32_t> seen;     // positions of the events this part must see
-        std::vector<std::uint32_t> corners;  // positions of the corners it found
+        std::vector<Event> events;           // those events, in order
+        std::vector<std::uint8_t> flags;     // the detector's answers for them
+        std::vector<std::uint32_t> corners;  // positions of the corners of its band
         std::size_t found = 0;
     };
 
     void run_part(std::size_t w, std::span<const Event> events) noexcept {
         const DetectPart part = parts_[w];
         Share& s = shares_[w];
-        D& det = *detectors_[w];
         const int lo = part.y0 - radius_;
         const int hi = part.y1 + radius_;
         // Branch-free selection of the events to see (polarity and rows are data and
-        // would mispredict), then a loop in which only band edges branch.
+        // would mispredict).
         std::size_t m = 0;
         for (std::size_t i = 0; i < events.size(); ++i) {
             const Event& e = events[i];
             s.seen[m] = static_cast<std::uint32_t>(i);
+            s.events[m] = e;
             m += ((part.polarities >> e.p) & 1u) & static_cast<unsigned>(e.y >= lo) & static_cast<unsigned>(e.y < hi);
         }
+        // The detector's own batch loop (eFAST's fastest path) over them all; answers for
+        // halo events are dropped (a halo is a few rows, and none between polarities).
+        detail::run_batch(*detectors_[w], std::span<const Event>(s.events.data(), m),
+                          std::span<std::uint8_t>(s.flags.data(), m));
         std::size_t found = 0;
         for (std::size_t k = 0; k < m; ++k) {
-            const std::uint32_t i = s.seen[k];
-            const Event& e = events[i];
-            if (e.y >= part.y0 && e.y < part.y1) {
-                s.corners[found] = i;
-                found += det.process(e);
-            } else {
-                observe(det, e);
-            }
+            const int y = s.events[k].y;
+            s.corners[found] = s.seen[k];
+            found += s.flags[k] & static_cast<unsigned>(y >= part.y0) & static_cast<unsigned>(y < part.y1);
         }
         s.found = found;
     }
