@@ -4,6 +4,9 @@
 
 #include "evcorner/efast.hpp"
 
+#include <cstdlib>
+#include <cstring>
+
 namespace evcorner {
 
 namespace {
@@ -29,6 +32,9 @@ struct Choice {
 };
 
 Choice choose() noexcept {
+    // EVCORNER_EFAST_PATH=portable forces the portable loop (to compare the two).
+    const char* forced = std::getenv("EVCORNER_EFAST_PATH");
+    if (forced != nullptr && std::strcmp(forced, "portable") == 0) return {detect_portable, "portable"};
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx2")) return {detect_avx2, "avx2"};

@@ -381,6 +381,7 @@ void write_json(const std::string& path, const std::vector<Row>& rows, const std
     j["compiler"] = compiler();
     j["build_type"] = EVCORNER_BUILD_TYPE;
     j["build_flags"] = EVCORNER_BUILD_FLAGS;
+    j["efast_code_path"] = efast_code_path();
     j["repeat"] = o.repeat;
     j["min_events"] = o.min_events;
     j["latency_clock_overhead_ns"] = o.no_latency ? nlohmann::json(nullptr) : nlohmann::json(clock.overhead_ns);
@@ -440,7 +441,8 @@ void run_bench(const BenchOptions& o) {
     fmt::print("evcorner bench: {} input(s), detectors {}, {} pass(es) each over >= {} events\n", o.inputs.size(),
                o.detectors, o.repeat, o.min_events);
     fmt::print("CPU      {}\n", cpu);
-    fmt::print("build    {} build, {}, flags: {}\n", EVCORNER_BUILD_TYPE, compiler(), EVCORNER_BUILD_FLAGS);
+    fmt::print("build    {} build, {}, flags: {}; eFAST code path: {}\n", EVCORNER_BUILD_TYPE, compiler(),
+               EVCORNER_BUILD_FLAGS, efast_code_path());
     fmt::print("method   one thread; throughput: steady_clock around detect() over the replayed stream,\n"
                "         fresh detector per pass; latency: rdtscp/lfence around each event, clock overhead\n"
                "         subtracted (fenced, so an upper bound)\n\n");
