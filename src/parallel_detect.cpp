@@ -89,36 +89,44 @@ void WorkerPool::run(const std::function<void(int)>& job) {
 
 std::vector<DetectPart> plan_parts(SensorSize size, int threads, std::span<const Event> sample) {
     threads = std::max(1, threads);
-    // Polarities are independent: split them first when the count allows.
-    const std::vector<unsigned> groups = threads % 2 == 0 ? std::vector<unsigned>{1u, 2u} : std::vector<unsigned>{3u};
-    const int bands = threads / static_cast<int>(groups.size());
-    std::vector<DetectPart> parts;
-    for (const unsigned g : groups) {
-        std::vector<std::uint64_t> rows(static_cast<std::size_t>(size.height), 0);
-        std::uint64_t total = 0;
-        for (const Event& e : sample)
-            if (((g >> e.p) & 1u) && e.y < size.height) {
-                ++rows[e.y];
-                ++total;
-            }
-        int y = 0;
-        std::uint64_t cum = 0;
-        for (int b = 0; b < bands; ++b) {
-            DetectPart part{g, y, size.height};
-            if (b + 1 < bands) {
-                int end = y;
-                if (total == 0) {
-                    end = static_cast<int>(static_cast<std::int64_t>(size.height) * (b + 1) / bands);
-                } else {
-                    // The band ends where the sample's cumulative count reaches (b+1)/bands.
-                    const std::uint64_t target = total * static_cast<std::uint64_t>(b + 1) / static_cast<std::uint64_t>(bands);
-                    while (end < size.height && cum + rows[static_cast<std::size_t>(end)] <= target) cum += rows[static_cast<std::size_t>(end++)];
-                }
-                part.y1 = std::max(y, end);
-            }
-            parts.push_back(part);
-            y = part.y1;
+    const int h = size.height;
+    // Cell c = p * h + y: OFF rows first, then ON rows; its share of the sample.
+    std::vector<std::uint64_t> count(2 * static_cast<std::size_t>(h), 0);
+    std::uint64_t total = 0;
+    for (const Event& e : sample)
+        if (e.y < h) {
+            ++count[static_cast<std::size_t>((e.p & 1) * h + e.y)];
+            ++total;
         }
+    const int cells = 2 * h;
+    std::vector<DetectPart> parts;
+    int c = 0;
+    std::uint64_t cum = 0;
+    for (int t = 0; t < threads; ++t) {
+        int end = cells;
+        if (t + 1 < threads) {
+            if (total == 0) {
+                end = static_cast<int>(static_cast<std::int64_t>(cells) * (t + 1) / threads);
+            } else {
+                // The run ends where the cumulative count comes closest to (t+1)/threads.
+                const std::uint64_t target = total * static_cast<std::uint64_t>(t + 1) / static_cast<std::uint64_t>(threads);
+                end = c;
+                while (end < cells && cum + count[static_cast<std::size_t>(end)] <= target) cum += count[static_cast<std::size_t>(end++)];
+                if (end < cells && target - cum > cum + count[static_cast<std::size_t>(end)] - target)
+                    cum += count[static_cast<std::size_t>(end++)];
+            }
+            end = std::max(c, end);
+        }
+        // Cells [c, end) as a band per polarity.
+        DetectPart part;
+        for (int p = 0; p < 2; ++p) {
+            const int from = std::clamp(c - p * h, 0, h);
+            const int to = std::clamp(end - p * h, 0, h);
+            part.y0[p] = from < to ? from : 0;
+            part.y1[p] = from < to ? to : 0;
+        }
+        parts.push_back(part);
+        c = end;
     }
     return parts;
 }

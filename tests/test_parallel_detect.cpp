@@ -100,6 +100,15 @@ TEST(ParallelDetect, HarrisRandomHdStream) {
     expect_same_as_one_thread<Harris>(events, hd, HarrisParams{}.window / 2, [&] { return Harris(hd); }, 9000);
 }
 
+TEST(ParallelDetect, TwoPartsSplitTheSampleInHalf) {
+    const SensorSize hd{1280, 720};
+    const auto events = random_stream(hd, 50000, 9);
+    const auto parts = plan_parts(hd, 2, events);
+    std::size_t first = 0;
+    for (const Event& e : events) first += parts[0].owns(e.p, e.y);
+    EXPECT_NEAR(static_cast<double>(first) / static_cast<double>(events.size()), 0.5, 0.01);
+}
+
 TEST(ParallelDetect, PartsCoverTheSensorOnce) {
     const SensorSize hd{1280, 720};
     const auto events = random_stream(hd, 20000, 3);
@@ -109,7 +118,7 @@ TEST(ParallelDetect, PartsCoverTheSensorOnce) {
         for (int p = 0; p < 2; ++p)
             for (int y = 0; y < hd.height; ++y) {
                 int owners = 0;
-                for (const auto& part : parts) owners += ((part.polarities >> p) & 1u) && y >= part.y0 && y < part.y1;
+                for (const auto& part : parts) owners += part.owns(p, y);
                 ASSERT_EQ(owners, 1) << threads << " threads, polarity " << p << ", row " << y;
             }
     }

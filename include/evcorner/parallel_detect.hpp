@@ -3,17 +3,17 @@
 //
 // A detector is *local* with radius r when whether event e is a corner depends only on
 // the earlier events of e's polarity within r pixels of e (eFAST: r = 4, the radius-4
-// circle; Harris: half its window). Then the sensor splits into parts, each a polarity
-// set times a band of rows [y0, y1): the thread of a part keeps its own detector, feeds
-// it, in input order, every event of its polarities in rows [y0 - r, y1 + r) (the band
-// and its halo), and keeps its answers only for the events of its band. Each event is classified
+// circle; Harris: half its window). Then the sensor splits into parts, each a band of
+// rows [y0[p], y1[p]) per polarity p: the thread of a part keeps its own detector, feeds
+// it, in input order, every event of polarity p in rows [y0[p] - r, y1[p] + r) (the band
+// and its halo), and keeps its answers only for the events of its bands. Each event is classified
 // by exactly one part, from a state identical to that of a single detector run over the
 // whole stream, so the flags are identical, in input order, for any number of threads.
 //
-// Parts: with an even thread count, polarities split first (no halo needed between
-// them), then rows; with an odd one, rows only. Band edges follow the distribution of
-// rows in the first batch, so that parts get similar numbers of events; they are fixed
-// from then on (each part's state only covers its band and halo).
+// Parts: the (polarity, row) cells, OFF rows then ON rows, cut into runs holding similar
+// numbers of the first batch's events (so two threads get OFF and ON split exactly in
+// half, although ON and OFF events are rarely half and half); fixed from then on (each
+// part's state only covers its bands and halos).
 //
 // Threads, clocks and allocation stay outside the detectors: detect() below is the
 // batch loop of detector.hpp, run by each thread on its share.
@@ -50,14 +50,18 @@ private:
     std::unique_ptr<State> state_;
 };
 
-/// One part of the sensor: the polarities it owns (bit p set) and its band of rows.
+/// One part of the sensor: for each polarity p, the band of rows [y0[p], y1[p]) it owns
+/// (empty when y0[p] == y1[p]).
 struct DetectPart {
-    unsigned polarities = 3;
-    int y0 = 0;
-    int y1 = 0;
+    int y0[2] = {0, 0};
+    int y1[2] = {0, 0};
+    [[nodiscard]] bool owns(int p, int y) const noexcept { return y >= y0[p] && y < y1[p]; }
 };
 
-/// Splits `size` into `threads` parts, bands balanced on the rows of `sample`.
+/// Splits `size` into `threads` parts with similar numbers of `sample`'s events: the
+/// (polarity, row) cells in the order OFF rows 0..H-1, then ON rows 0..H-1, cut into
+/// `threads` runs. A run holds one band of one polarity, or the end of OFF and the start
+/// of ON; no halo is needed between polarities.
 std::vector<DetectPart> plan_parts(SensorSize size, int threads, std::span<const Event> sample);
 
 namespace detail {
@@ -145,8 +149,13 @@ private:
     void run_part(std::size_t w, std::span<const Event> events) noexcept {
         const DetectPart part = parts_[w];
         Share& s = shares_[w];
-        const int lo = part.y0 - radius_;
-        const int hi = part.y1 + radius_;
+        // Rows to see per polarity: the band and its halo, or nothing.
+        int lo[2], hi[2];
+        for (int p = 0; p < 2; ++p) {
+            const bool empty = part.y0[p] >= part.y1[p];
+            lo[p] = empty ? 0 : part.y0[p] - radius_;
+            hi[p] = empty ? 0 : part.y1[p] + radius_;
+        }
         // Branch-free selection of the events to see (polarity and rows are data and
         // would mispredict).
         std::size_t m = 0;
@@ -154,17 +163,18 @@ private:
             const Event& e = events[i];
             s.seen[m] = static_cast<std::uint32_t>(i);
             s.events[m] = e;
-            m += ((part.polarities >> e.p) & 1u) & static_cast<unsigned>(e.y >= lo) & static_cast<unsigned>(e.y < hi);
+            const int p = e.p & 1;
+            m += static_cast<unsigned>(e.y >= lo[p]) & static_cast<unsigned>(e.y < hi[p]);
         }
         // The detector's own batch loop (eFAST's fastest path) over them all; answers for
-        // halo events are dropped (a halo is a few rows, and none between polarities).
+        // halo events are dropped (a halo is a few rows).
         detail::run_batch(*detectors_[w], std::span<const Event>(s.events.data(), m),
                           std::span<std::uint8_t>(s.flags.data(), m));
         std::size_t found = 0;
         for (std::size_t k = 0; k < m; ++k) {
-            const int y = s.events[k].y;
+            const Event& e = s.events[k];
             s.corners[found] = s.seen[k];
-            found += s.flags[k] & static_cast<unsigned>(y >= part.y0) & static_cast<unsigned>(y < part.y1);
+            found += s.flags[k] & static_cast<unsigned>(part.owns(e.p & 1, e.y));
         }
         s.found = found;
     }
