@@ -76,8 +76,9 @@ void add_convert_command(CLI::App& app) {
     auto o = std::make_shared<ConvertOptions>();
     CLI::App* cmd = app.add_subcommand(
         "convert",
-        "Convert an event file to another format. The input format is told by the content\n"
-        "(or --format); the output format by OUTPUT's extension (.txt, .csv, .npy, .aedat4) or --to.");
+        "Convert an event file to another format.\n"
+        "The input format is told by the content (or --format); the output format by OUTPUT's\n"
+        "extension (.txt, .csv, .npy, .aedat4, .h5) or --to.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     cmd->add_option("OUTPUT", o->output, "Output file (- = standard output, text formats)")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);

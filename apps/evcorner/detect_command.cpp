@@ -249,11 +249,11 @@ void add_detect_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "detect",
         "Detect corner events in an event stream and write them out.\n"
-        "Input: any format evcorner reads, told by the content (or --format): Event-Camera-\n"
-        "Dataset text ('t x y p' per line, t in seconds, p = 1 ON / 0 OFF), CSV, .npy, AEDAT 2,\n"
-        "Prophesee EVT 2/EVT 3/DAT; '-' reads standard input. Output: the corner events, as\n"
-        "text unless OUTPUT's extension or --to names another format. A summary (events,\n"
-        "corners, reduction rate, detection time per event, wall time) goes to standard error.");
+        "Input: any format evcorner reads (see --format), told by the content; '-' reads\n"
+        "standard input. Event-Camera-Dataset text is 't x y p' per line, t in seconds,\n"
+        "p = 1 ON / 0 OFF. Output: the corner events, as such text lines unless OUTPUT's\n"
+        "extension or --to names another format. A summary (events, corners, reduction rate,\n"
+        "detection time per event, wall time) goes to standard error.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     cmd->add_option("-d,--detector", o->detector, "Detector to run:" + detectors)
         ->capture_default_str()

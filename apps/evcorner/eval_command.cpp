@@ -324,9 +324,10 @@ void add_eval_command(CLI::App& app) {
     auto o = std::make_shared<EvalOptions>();
     CLI::App* cmd = app.add_subcommand(
         "eval",
-        "Evaluate detectors as Mueggler et al. (BMVC 2017) do: per sequence the reduction rate\n"
-        "and the share of corner events on feature tracks (Table 1), per detector the time per\n"
-        "event and the largest event rate it sustains (Table 2).");
+        "Evaluate detectors on sequences: the paper's Tables 1 and 2, a report with figures.\n"
+        "As Mueggler et al. (BMVC 2017) do: per sequence the reduction rate and the share of\n"
+        "corner events on feature tracks (Table 1), per detector the time per event and the\n"
+        "largest event rate it sustains (Table 2).");
     cmd->add_option("INPUTS", o->inputs,
                     "Sequence files, or folders in the dataset's layout <sequence>/events.txt")
         ->required();
@@ -341,7 +342,7 @@ void add_eval_command(CLI::App& app) {
     add_feature_track_options(*cmd, o->params, o->overlap);
     cmd->footer(
         "Examples:\n"
-        "  evcorner eval /work/shared/data/real/ecd-stppp --report eval-report\n"
+        "  evcorner eval ../shared/data/real/ecd-stppp --report eval-report\n"
         "  evcorner eval a/events.txt b.txt -d efast,harris --repeat 3");
     cmd->callback([o] { run_eval(*o); });
 }

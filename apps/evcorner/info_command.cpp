@@ -142,8 +142,9 @@ void add_info_command(CLI::App& app) {
     auto o = std::make_shared<InfoOptions>();
     CLI::App* cmd = app.add_subcommand(
         "info",
-        "Describe an event file: format, sensor size, events, time span, mean and peak\n"
-        "rate, ON/OFF counts, x/y ranges. Reads the whole file once, in constant memory.");
+        "Describe an event file: format, sensor size, events, time span, rates, ON/OFF.\n"
+        "Prints the format, sensor size, events, time span, mean and peak rate, ON/OFF counts\n"
+        "and x/y ranges. Reads the whole file once, in constant memory.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")

@@ -71,9 +71,9 @@ void add_label_command(CLI::App& app) {
     auto o = std::make_shared<LabelOptions>();
     CLI::App* cmd = app.add_subcommand(
         "label",
-        "Label corner events as on a feature track (1) or not (0), the ground truth of\n"
-        "Mueggler et al. (BMVC 2017, Sec. 3.1.2), and print FT, the share on tracks.\n"
-        "Input: corner events of any detector in any format evcorner reads.");
+        "Label corner events as on a feature track (1) or not (0) and print FT.\n"
+        "The ground truth of Mueggler et al. (BMVC 2017, Sec. 3.1.2); FT is the share of corner\n"
+        "events on tracks. Input: corner events of any detector in any format evcorner reads.");
     cmd->add_option("CORNERS", o->input, "Corner-event file, or - for standard input")->required();
     cmd->add_option("-o,--output", o->output, "Write one line per corner event: 1 on a track, 0 not (- = stdout)");
     cmd->add_option("--json", o->json, "Also write the figures as JSON to this file");

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
+#include <string>
 
 #include "commands.hpp"
 
@@ -18,8 +19,8 @@ int main(int argc, char** argv) {
     app.footer(
         "Example:\n"
         "  evcorner detect events.txt -o corners.txt     # Event-Camera-Dataset text in and out\n"
-        "  evcorner info recording.aedat                 # what a file holds (AEDAT2, EVT2/3, DAT, CSV, npy)\n"
-        "  evcorner convert recording.raw events.npy     # any readable format to text, CSV or npy\n"
+        "  evcorner info recording.aedat                 # what a file holds (any readable format)\n"
+        "  evcorner convert recording.raw events.npy     # to text, CSV, npy, AEDAT 4 or HDF5\n"
         "  evcorner eval data/ecd --report report        # the paper's Tables 1 and 2, figures\n"
         "  evcorner bench events.txt                     # ns/event, max rate, latency on this machine\n"
         "Exit status: 0 on success, 1 on bad input or a failed write, 2 on a usage error.");
@@ -30,6 +31,15 @@ int main(int argc, char** argv) {
     evcorner::cli::add_eval_command(app);
     evcorner::cli::add_render_command(app);
     evcorner::cli::add_bench_command(app);
+    // The command list shows each command's first line; the rest of its description
+    // heads its own --help, before the examples.
+    for (CLI::App* cmd : app.get_subcommands({})) {
+        const std::string text = cmd->get_description();
+        const auto nl = text.find('\n');
+        if (nl == std::string::npos) continue;
+        cmd->footer(text.substr(nl + 1) + "\n\n" + cmd->get_footer());
+        cmd->description(text.substr(0, nl));
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

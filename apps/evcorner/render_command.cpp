@@ -77,9 +77,10 @@ void add_render_command(CLI::App& app) {
     auto o = std::make_shared<RenderOptions>();
     CLI::App* cmd = app.add_subcommand(
         "render",
-        "Draw the paper's figures as PNG: sae (Fig. 2b), corners (Fig. 6: events of the last\n"
-        "33 ms, corner events of the last 33 ms bright and 100 ms dark, green ON / red OFF),\n"
-        "space-time (Fig. 1b) and labels (Fig. 5b: green on a feature track, red off it).");
+        "Draw the paper's figures as PNG: SAE, corners, space-time view, labelled corners.\n"
+        "Kinds: sae (Fig. 2b), corners (Fig. 6: events of the last 33 ms, corner events of the\n"
+        "last 33 ms bright and 100 ms dark, green ON / red OFF), space-time (Fig. 1b) and labels\n"
+        "(Fig. 5b: green on a feature track, red off it).");
     cmd->add_option("INPUT", o->input, "Event file (any format evcorner reads)")->required();
     cmd->add_option("-o,--output", o->output, "PNG file to write")->required();
     cmd->add_option("-k,--kind", o->kind, "sae, corners, space-time or labels")
