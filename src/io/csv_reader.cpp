@@ -133,11 +133,11 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
             std::int64_t ip = 0;
             int digits = 0;
             while (q < fe && is_digit(*q)) {
-                ip = ip * 10 + (*q++ - '0');
-                if (++digits > 18) {
+                if (++digits > 18) {  // before the multiplication: 19 digits overflow int64
                     why = "timestamp too large";
                     return false;
                 }
+                ip = ip * 10 + (*q++ - '0');
             }
             std::int64_t frac = 0;  // the first time_digits_ + 1 fractional digits
             int fd = 0;
