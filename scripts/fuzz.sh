@@ -47,7 +47,8 @@ for t in "${targets[@]}"; do
   # the library where evcorner cannot guard. fuzz_hdf5 runs and reports, but does not
   # fail the run; every other target does.
   [ "$t" = hdf5 ] && extra=(-detect_leaks=0)
-  if "$build/bin/fuzz_$t" "$build/corpus/$t" -max_total_time="$secs" -rss_limit_mb=2048 -timeout=10 \
+  # A fixed seed by default, so that a CI run can be repeated; FUZZ_SEED=0 picks one at random.
+  if "$build/bin/fuzz_$t" "$build/corpus/$t" -max_total_time="$secs" -seed="${FUZZ_SEED:-1}" -rss_limit_mb=2048 -timeout=10 \
        -max_len=65536 -print_final_stats=1 "${extra[@]}" -artifact_prefix="$build/artifacts/$t-" >"$log" 2>&1; then
     runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
     echo "fuzz_$t: ok, $runs executions in ${secs} s"
