@@ -136,6 +136,36 @@ TEST_F(Cli, MalformedLineStopsWithFileLineAndKeepsWholeLines) {
     EXPECT_EQ(count_lines(slurp(dir_ / "mask.txt")), 30000u);
 }
 
+TEST_F(Cli, CutShortBinaryFileIsAnErrorUnlessAllowed) {
+    ASSERT_EQ(run("convert '" + sample_.string() + "' events.npy -q").status, 0);
+    std::string bytes = slurp(dir_ / "events.npy");
+    bytes.resize(bytes.size() - 16 * 1000 - 5);  // the last 1000 records and part of one more
+    write("cut.npy", bytes);
+    const Result whole = run("detect '" + sample_.string() + "' -q -o all.txt");
+    ASSERT_EQ(whole.status, 0);
+
+    Result r = run("detect cut.npy -o corners.txt");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("cut.npy: byte "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("28999 events before the error"), std::string::npos) << r.err;
+
+    r = run("detect cut.npy -o corners.txt --allow-damaged --summary-json s.json");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("cut.npy: byte "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("events       28999"), std::string::npos) << r.err;
+    EXPECT_NE(slurp(dir_ / "s.json").find("\"damaged\": \""), std::string::npos);
+    // The corners are those of the first 28 999 events: a prefix of the whole file's.
+    const std::string all = slurp(dir_ / "all.txt");
+    const std::string part = slurp(dir_ / "corners.txt");
+    EXPECT_FALSE(part.empty());
+    EXPECT_EQ(all.compare(0, part.size(), part), 0);
+
+    r = run("convert cut.npy back.txt --allow-damaged");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(count_lines(slurp(dir_ / "back.txt")), 28999u);
+}
+
 TEST_F(Cli, OutsideTheSensor) {
     write("big.txt", "0.1 5 5 1\n0.2 300 10 0\n0.3 6 6 1\n");
     Result r = run("detect big.txt");

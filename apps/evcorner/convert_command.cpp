@@ -28,6 +28,7 @@ struct ConvertOptions {
     std::string csv_columns;
     std::string time_unit = "us";
     bool skip_invalid = false;
+    bool allow_damaged = false;
     bool quiet = false;
 };
 
@@ -56,10 +57,13 @@ void run_convert(const ConvertOptions& o) {
             writer->write(std::span<const Event>(buf.data(), n));
             events += n;
         }
-    } catch (const InputError&) {
-        writer->close();
-        fmt::print(stderr, "evcorner: the {} events before the error are written to {}\n", events, writer->name());
-        throw;
+    } catch (const InputError& e) {
+        if (!o.allow_damaged) {
+            writer->close();
+            fmt::print(stderr, "evcorner: the {} events before the error are written to {}\n", events, writer->name());
+            throw;
+        }
+        fmt::print(stderr, "evcorner: warning: {}; the {} events before it are written\n", e.what(), events);
     }
     writer->close();
     if (!o.quiet) {
@@ -89,6 +93,9 @@ void add_convert_command(CLI::App& app) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
         });
     cmd->add_flag("--skip-invalid", o->skip_invalid, "Skip (and count) events outside --size instead of failing");
+    cmd->add_flag("--allow-damaged", o->allow_damaged,
+                  "A damaged or cut-short input ends with a warning and exit status 0, instead of an "
+                  "error: the events before the damage are the output");
     cmd->add_flag("-q,--quiet", o->quiet, "No summary line");
     cmd->footer("Examples:\n  evcorner convert recording.aedat events.npy\n  evcorner convert events.raw - --to csv | head");
     cmd->callback([o] { run_convert(*o); });

@@ -43,6 +43,7 @@ struct DetectOptions {
     std::string mask;
     std::string summary_json;
     bool skip_invalid = false;
+    bool allow_damaged = false;
     bool with_score = false;
     DetectorParams params;
     bool quiet = false;
@@ -56,6 +57,7 @@ struct Totals {
     std::uint64_t skipped = 0;
     double detect_s = 0;
     double wall_s = 0;
+    std::string damaged;  ///< the input error the run stopped at under --allow-damaged
 };
 
 void write_mask(io::OutputFile& mask, const std::vector<std::uint8_t>& flags, std::size_t n,
@@ -85,6 +87,7 @@ void print_summary(const DetectOptions& o, SensorSize size, const Totals& t) {
         fmt::print(stderr, "  detection    {:.1f} ns/event (detector alone; {:.2f} M events/s)\n",
                    t.detect_s * 1e9 / events, events / t.detect_s / 1e6);
     }
+    if (!t.damaged.empty()) fmt::print(stderr, "  damaged      input ends at: {}\n", t.damaged);
     fmt::print(stderr, "  wall time    {:.3f} s ({:.2f} M events/s end to end)\n", t.wall_s,
                t.wall_s > 0 ? events / t.wall_s / 1e6 : 0.0);
 }
@@ -108,6 +111,10 @@ void write_summary_json(const DetectOptions& o, SensorSize size, const Totals& t
     }
     j["detect_s"] = t.detect_s;
     j["wall_s"] = t.wall_s;
+    if (t.damaged.empty())
+        j["damaged"] = nullptr;
+    else
+        j["damaged"] = t.damaged;
     io::OutputFile out(o.summary_json);
     out.write(j.dump(2));
     out.write("\n");
@@ -220,18 +227,26 @@ void run_detect(const DetectOptions& o) {
                 },
                 detector);
         }
-    } catch (const InputError&) {
+    } catch (const InputError& e) {
         progress.finish();
         finish_outputs();
-        if (totals.events > 0)
-            fmt::print(stderr,
-                       "evcorner: the {} events before the error were processed; their {} "
-                       "corners are written\n",
-                       totals.events, totals.corners);
-        throw;
+        if (!o.allow_damaged) {
+            if (totals.events > 0)
+                fmt::print(stderr,
+                           "evcorner: the {} events before the error were processed; their {} "
+                           "corners are written\n",
+                           totals.events, totals.corners);
+            throw;
+        }
+        // --allow-damaged: the valid part before the damage is the result.
+        fmt::print(stderr, "evcorner: warning: {}; the {} events before it were processed\n", e.what(),
+                   totals.events);
+        totals.damaged = e.what();
     }
-    progress.finish();
-    finish_outputs();
+    if (totals.damaged.empty()) {
+        progress.finish();
+        finish_outputs();
+    }
     totals.skipped = reader.skipped();
     totals.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
@@ -303,6 +318,9 @@ void add_detect_command(CLI::App& app) {
                     "with a halo of the detector's radius; output identical to one thread, same order")
         ->capture_default_str()
         ->check(CLI::Range(1, 256));
+    cmd->add_flag("--allow-damaged", o->allow_damaged,
+                  "A malformed line or a damaged or cut-short file ends the input with a warning "
+                  "and exit status 0, instead of an error: the events before it are the result");
     cmd->add_flag("--skip-invalid", o->skip_invalid,
                   "Skip events outside the sensor (counted in the summary) instead of failing");
     cmd->add_flag("-q,--quiet", o->quiet, "No summary and no progress bar");

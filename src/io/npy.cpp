@@ -129,7 +129,9 @@ NpyReader::NpyReader(std::string path, ReaderOptions options) : BinaryReader(std
     declared_ = n;
     if (const auto total = bytes_total()) {
         const std::uint64_t body = *total - offset();
-        if (body / itemsize_ < declared_ || body % itemsize_ != 0 || body / itemsize_ > declared_)
+        // Fewer bytes than declared is a cut-short file: decode() returns the events that are
+        // there and then reports where it ends. More is a header that does not describe the data.
+        if (body / itemsize_ > declared_ || (body / itemsize_ == declared_ && body % itemsize_ != 0))
             fail(offset(), fmt::format("the header declares {} events of {} bytes but {} bytes follow it",
                                        declared_, itemsize_, body));
     }
