@@ -12,7 +12,6 @@ namespace evcorner::io {
 
 namespace {
 
-constexpr std::size_t kBufferSize = 1 << 20;
 constexpr std::int64_t kPow10[] = {1, 10, 100, 1000, 10000, 100000, 1000000};
 
 inline bool is_space(char c) { return c == ' ' || c == '\t'; }
@@ -28,28 +27,17 @@ std::string lower_trim(std::string_view s) {
     return r;
 }
 
-std::string quote(const char* b, const char* e) {
-    std::string s;
-    const bool cut = e - b > 80;
-    if (cut) e = b + 80;
-    for (const char* p = b; p < e; ++p) {
-        const auto c = static_cast<unsigned char>(*p);
-        s += c >= 0x20 && c < 0x7f ? std::string(1, static_cast<char>(c)) : fmt::format("\\x{:02x}", c);
-    }
-    return "'" + s + (cut ? "...'" : "'");
-}
-
 }  // namespace
 
 CsvReader::CsvReader(std::string path, ReaderOptions options)
-    : file_(std::move(path)), options_(std::move(options)), buf_(kBufferSize) {
+    : lines_(std::move(path)), options_(std::move(options)) {
     sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
     const std::string& u = options_.csv_time_unit;
     if (u == "us") time_digits_ = 0;
     else if (u == "ms") time_digits_ = 3;
     else if (u == "s") time_digits_ = 6;
     else if (u == "ns") time_div_ = 1000;
-    else throw InputError(file_.name(), "unknown CSV time unit '" + u + "' (us, ns, ms or s)");
+    else throw InputError(lines_.file().name(), "unknown CSV time unit '" + u + "' (us, ns, ms or s)");
     if (!options_.csv_columns.empty()) set_columns(options_.csv_columns, false);
 }
 
@@ -66,51 +54,21 @@ void CsvReader::set_columns(const std::string& spec, bool from_header) {
         else if (name == "y") f = kY;
         else if (name == "p" || name == "pol" || name == "polarity") f = kP;
         else if (!from_header && name != "_")
-            throw InputError(file_.name(), "unknown CSV column '" + name + "' in '" + spec +
+            throw InputError(lines_.file().name(), "unknown CSV column '" + name + "' in '" + spec +
                                                "' (t, x, y, p, or _ to ignore one)");
         if (f != kIgnore && seen[f]++ > 0)
-            throw InputError(file_.name(), "CSV column '" + name + "' named twice in '" + spec + "'");
+            throw InputError(lines_.file().name(), "CSV column '" + name + "' named twice in '" + spec + "'");
         cols.push_back(f);
         if (comma == std::string::npos) break;
         start = comma + 1;
     }
     if (std::count(seen.begin(), seen.end(), 1) != 4) {
         const std::string why = "CSV columns '" + spec + "' do not name each of t, x, y and p";
-        if (from_header) throw InputError(file_.name(), InputError::Unit::line, line_, why);
-        throw InputError(file_.name(), why);
+        if (from_header) throw InputError(lines_.file().name(), InputError::Unit::line, lines_.line(), why);
+        throw InputError(lines_.file().name(), why);
     }
     columns_ = std::move(cols);
     columns_known_ = true;
-}
-
-void CsvReader::fail(const char* begin, const char* end, const std::string& reason) const {
-    throw InputError(file_.name(), InputError::Unit::line, line_, reason + ": " + quote(begin, end));
-}
-
-bool CsvReader::next_line(const char*& begin, const char*& end) {
-    for (;;) {
-        const char* data = buf_.data();
-        const void* nl = std::memchr(data + pos_, '\n', fill_ - pos_);
-        if (nl != nullptr || (eof_ && pos_ < fill_)) {
-            begin = data + pos_;
-            end = nl ? static_cast<const char*>(nl) : data + fill_;
-            pos_ = static_cast<std::size_t>(end - data) + (nl ? 1 : 0);
-            ++line_;
-            if (end > begin && end[-1] == '\r') --end;
-            return true;
-        }
-        if (eof_) return false;
-        if (pos_ == 0 && fill_ == buf_.size()) {
-            ++line_;
-            fail(data, data + 80, fmt::format("line longer than {} bytes", buf_.size()));
-        }
-        std::memmove(buf_.data(), buf_.data() + pos_, fill_ - pos_);
-        fill_ -= pos_;
-        pos_ = 0;
-        const std::size_t n = file_.read(std::span<char>(buf_.data() + fill_, buf_.size() - fill_));
-        if (n == 0) eof_ = true;
-        fill_ += n;
-    }
 }
 
 bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& why) const {
@@ -204,13 +162,13 @@ std::size_t CsvReader::read(std::span<Event> out) {
     try {
         const char* b;
         const char* e;
-        while (n < out.size() && next_line(b, e)) {
+        while (n < out.size() && lines_.next(b, e)) {
             const char* q = b;
             while (q < e && is_space(*q)) ++q;
             if (q == e || *q == '#') continue;
             if (!is_digit(*q) && *q != '-' && *q != '+' && *q != '.') {
                 // A header row: names the columns unless the options did.
-                if (seen_row_) fail(b, e, "text where an event was expected");
+                if (seen_row_) lines_.fail(b, e, "text where an event was expected");
                 seen_row_ = true;
                 if (options_.csv_columns.empty()) set_columns(std::string(b, e), true);
                 continue;
@@ -219,12 +177,12 @@ std::size_t CsvReader::read(std::span<Event> out) {
             seen_row_ = true;
             Event ev{};
             const char* why = nullptr;
-            if (!parse(b, e, ev, why)) fail(b, e, why);
+            if (!parse(b, e, ev, why)) lines_.fail(b, e, why);
             if (ev.t < last_t_)
-                fail(b, e, fmt::format("timestamp goes backwards ({} us before the previous event)", last_t_ - ev.t));
+                lines_.fail(b, e, fmt::format("timestamp goes backwards ({} us before the previous event)", last_t_ - ev.t));
             if (sensor_ && !sensor_->contains(ev)) {
                 if (!options_.skip_invalid)
-                    fail(b, e, fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, "
+                    lines_.fail(b, e, fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, "
                                            "or --skip-invalid to skip such events)",
                                            ev.x, ev.y, sensor_->width, sensor_->height));
                 ++skipped_;

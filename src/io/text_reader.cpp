@@ -10,27 +10,11 @@ namespace evcorner::io {
 
 namespace {
 
-constexpr std::size_t kBufferSize = 1 << 20;
 // |t| below this many seconds keeps t in microseconds far from int64 overflow.
 constexpr std::int64_t kMaxSeconds = 9'000'000'000'000;
 
 inline bool is_space(char c) { return c == ' ' || c == '\t'; }
 inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
-
-// The offending line, shortened and with unprintable bytes escaped.
-std::string quote(const char* b, const char* e) {
-    std::string s;
-    const bool cut = e - b > 80;
-    if (cut) e = b + 80;
-    for (const char* p = b; p < e; ++p) {
-        const auto c = static_cast<unsigned char>(*p);
-        if (c >= 0x20 && c < 0x7f)
-            s += static_cast<char>(c);
-        else
-            s += fmt::format("\\x{:02x}", c);
-    }
-    return "'" + s + (cut ? "...'" : "'");
-}
 
 struct Parsed {
     Event e{};
@@ -102,46 +86,7 @@ Parsed parse_line(const char* p, const char* end) {
 }  // namespace
 
 TextReader::TextReader(std::string path, ReaderOptions options)
-    : file_(std::move(path)), options_(options), buf_(kBufferSize) {}
-
-void TextReader::fail(const char* begin, const char* end, const std::string& reason) const {
-    throw InputError(file_.name(), InputError::Unit::line, line_,
-                     reason + ": " + quote(begin, end));
-}
-
-// Finds the next line in the buffer, refilling it as needed. [begin, end) excludes
-// the line break. Returns false at end of input.
-bool TextReader::next_line(const char*& begin, const char*& end) {
-    for (;;) {
-        const char* data = buf_.data();
-        const void* nl = std::memchr(data + pos_, '\n', fill_ - pos_);
-        if (nl != nullptr) {
-            begin = data + pos_;
-            end = static_cast<const char*>(nl);
-            pos_ = static_cast<std::size_t>(end - data) + 1;
-            ++line_;
-            return true;
-        }
-        if (eof_) {
-            if (pos_ == fill_) return false;
-            begin = data + pos_;  // last line without a line break
-            end = data + fill_;
-            pos_ = fill_;
-            ++line_;
-            return true;
-        }
-        if (pos_ == 0 && fill_ == buf_.size()) {
-            ++line_;
-            fail(data, data + 80, fmt::format("line longer than {} bytes", buf_.size()));
-        }
-        std::memmove(buf_.data(), buf_.data() + pos_, fill_ - pos_);
-        fill_ -= pos_;
-        pos_ = 0;
-        const std::size_t n = file_.read(std::span<char>(buf_.data() + fill_, buf_.size() - fill_));
-        if (n == 0) eof_ = true;
-        fill_ += n;
-    }
-}
+    : lines_(std::move(path)), options_(options) {}
 
 std::size_t TextReader::read(std::span<Event> out) {
     skipped_in_batch_.clear();
@@ -150,20 +95,19 @@ std::size_t TextReader::read(std::span<Event> out) {
     try {
         const char* b;
         const char* e;
-        while (n < out.size() && next_line(b, e)) {
-            if (e > b && e[-1] == '\r') --e;
+        while (n < out.size() && lines_.next(b, e)) {
             const char* q = b;
             while (q < e && is_space(*q)) ++q;
             if (q == e || *q == '#') continue;
             const Parsed r = parse_line(b, e);
-            if (r.error != nullptr) fail(b, e, r.error);
+            if (r.error != nullptr) lines_.fail(b, e, r.error);
             if (r.e.t < last_t_)
-                fail(b, e,
+                lines_.fail(b, e,
                      fmt::format("timestamp goes backwards ({} us before the previous event)",
                                  last_t_ - r.e.t));
             if (options_.sensor && !options_.sensor->contains(r.e)) {
                 if (!options_.skip_invalid)
-                    fail(b, e,
+                    lines_.fail(b, e,
                          fmt::format("event at x={} y={} lies outside the {}x{} sensor "
                                      "(set --size, or --skip-invalid to skip such events)",
                                      r.e.x, r.e.y, options_.sensor->width,

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "evcorner/io/event_reader.hpp"
-#include "evcorner/io/input_file.hpp"
+#include "evcorner/io/line_source.hpp"
 
 namespace evcorner::io {
 
@@ -27,18 +27,16 @@ public:
     [[nodiscard]] std::uint64_t skipped() const noexcept override { return skipped_; }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
     [[nodiscard]] std::string_view format() const noexcept override { return "csv"; }
-    [[nodiscard]] const std::string& name() const noexcept override { return file_.name(); }
-    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return file_.consumed(); }
-    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return file_.size(); }
+    [[nodiscard]] const std::string& name() const noexcept override { return lines_.file().name(); }
+    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return lines_.file().consumed(); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return lines_.file().size(); }
 
 private:
     enum Field : std::uint8_t { kT, kX, kY, kP, kIgnore };
-    bool next_line(const char*& begin, const char*& end);
-    [[noreturn]] void fail(const char* begin, const char* end, const std::string& reason) const;
     void set_columns(const std::string& spec, bool from_header);
     bool parse(const char* b, const char* e, Event& ev, const char*& why) const;
 
-    InputFile file_;
+    LineSource lines_;
     ReaderOptions options_;
     std::optional<SensorSize> sensor_;
     std::vector<Field> columns_;
@@ -46,10 +44,6 @@ private:
     std::int64_t time_div_ = 1;  // ns: 1000
     bool columns_known_ = false;
     bool seen_row_ = false;  // a header row may only come first
-    std::vector<char> buf_;
-    std::size_t pos_ = 0, fill_ = 0;
-    bool eof_ = false;
-    std::uint64_t line_ = 0;
     std::int64_t last_t_ = INT64_MIN;
     std::uint64_t skipped_ = 0;
     std::vector<SkipRun> skipped_in_batch_;

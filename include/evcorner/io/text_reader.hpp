@@ -17,7 +17,7 @@
 
 #include "evcorner/event.hpp"
 #include "evcorner/io/event_reader.hpp"
-#include "evcorner/io/input_file.hpp"
+#include "evcorner/io/line_source.hpp"
 #include "evcorner/sensor.hpp"
 
 namespace evcorner::io {
@@ -39,24 +39,16 @@ public:
     [[nodiscard]] std::uint64_t skipped() const noexcept override { return skipped_; }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return options_.sensor; }
     [[nodiscard]] std::string_view format() const noexcept override { return "ecd-text"; }
-    [[nodiscard]] const std::string& name() const noexcept override { return file_.name(); }
-    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return file_.consumed(); }
-    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return file_.size(); }
+    [[nodiscard]] const std::string& name() const noexcept override { return lines_.file().name(); }
+    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return lines_.file().consumed(); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return lines_.file().size(); }
     [[nodiscard]] std::uint64_t events() const noexcept { return events_; }
     /// Lines consumed so far.
-    [[nodiscard]] std::uint64_t line() const noexcept { return line_; }
+    [[nodiscard]] std::uint64_t line() const noexcept { return lines_.line(); }
 
 private:
-    bool next_line(const char*& begin, const char*& end);
-    [[noreturn]] void fail(const char* begin, const char* end, const std::string& reason) const;
-
-    InputFile file_;
+    LineSource lines_;
     ReaderOptions options_;
-    std::vector<char> buf_;
-    std::size_t pos_ = 0;    // start of unparsed data in buf_
-    std::size_t fill_ = 0;   // bytes valid in buf_
-    bool eof_ = false;
-    std::uint64_t line_ = 0;
     std::uint64_t events_ = 0;
     std::uint64_t skipped_ = 0;
     std::int64_t last_t_ = INT64_MIN;
