@@ -96,11 +96,7 @@ bool Aedat2Reader::decode() {
     for (std::size_t i = 0; i < records; ++i, p += kRecord) {
         const std::uint32_t a = be32(p);
         const std::uint32_t raw = be32(p + 4);
-        // A backwards jump of more than half the range is the 32-bit counter wrapping.
-        if (have_t_ && raw < last_raw_t_ && last_raw_t_ - raw > 0x8000'0000u) epoch_ += std::int64_t{1} << 32;
-        last_raw_t_ = raw;
-        have_t_ = true;
-        const std::int64_t t = epoch_ + raw;
+        const std::int64_t t = unwrap_(raw);
         if (layout_ == Layout::davis) {
             if ((a & 0x8000'0400u) != 0) {
                 ++other_words_;

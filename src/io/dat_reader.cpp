@@ -44,15 +44,13 @@ bool DatReader::decode() {
     for (std::size_t i = 0; i < records; ++i, p += kRecord) {
         const std::uint32_t raw = le32(p);
         const std::uint32_t d = le32(p + 4);
-        if (have_t_ && raw < last_raw_t_ && last_raw_t_ - raw > 0x8000'0000u) epoch_ += std::int64_t{1} << 32;
-        last_raw_t_ = raw;
-        have_t_ = true;
+        const std::int64_t t = unwrap_(raw);
         const std::uint32_t pol = d >> 28;
         if (pol > 1) [[unlikely]] {
             consume(i * kRecord);
             fail(base + i * kRecord, fmt::format("polarity {} where 0 or 1 is expected", pol));
         }
-        push(epoch_ + raw, d & 0x3FFF, (d >> 14) & 0x3FFF, pol == 1, base + i * kRecord);
+        push(t, d & 0x3FFF, (d >> 14) & 0x3FFF, pol == 1, base + i * kRecord);
     }
     consume(records * kRecord);
     return true;

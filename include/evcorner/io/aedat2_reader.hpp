@@ -38,9 +38,7 @@ private:
     std::string chip_;
     Layout layout_ = Layout::davis;
     std::uint64_t other_words_ = 0;
-    std::uint32_t last_raw_t_ = 0;
-    std::int64_t epoch_ = 0;  // multiples of 2^32 us added by time wraps
-    bool have_t_ = false;
+    Unwrap32 unwrap_;  // the 32-bit time counter
 };
 
 }  // namespace evcorner::io

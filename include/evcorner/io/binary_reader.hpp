@@ -25,6 +25,23 @@
 
 namespace evcorner::io {
 
+/// A 32-bit microsecond counter made monotonic: a backwards jump of more than half the
+/// counter's range is the counter wrapping, which adds 2^32 us from then on.
+class Unwrap32 {
+public:
+    std::int64_t operator()(std::uint32_t raw) noexcept {
+        if (have_ && raw < last_ && last_ - raw > 0x8000'0000u) epoch_ += std::int64_t{1} << 32;
+        last_ = raw;
+        have_ = true;
+        return epoch_ + raw;
+    }
+
+private:
+    std::int64_t epoch_ = 0;
+    std::uint32_t last_ = 0;
+    bool have_ = false;
+};
+
 class BinaryReader : public EventReader {
 public:
     std::size_t read(std::span<Event> out) final;

@@ -26,9 +26,7 @@ private:
     bool decode() override;
 
     int event_type_ = 0;
-    std::uint32_t last_raw_t_ = 0;
-    std::int64_t epoch_ = 0;
-    bool have_t_ = false;
+    Unwrap32 unwrap_;  // the 32-bit time counter
 };
 
 }  // namespace evcorner::io
