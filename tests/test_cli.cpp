@@ -2,9 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -12,52 +9,20 @@
 
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/text_reader.hpp"
-#include "test_util.hpp"
+#include "cli_test_util.hpp"
 
 namespace evcorner {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-    int status;
-    std::string out;
-    std::string err;
-};
+using Result = test::CliResult;
+using test::count_lines;
+using test::slurp;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-std::size_t count_lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
-
-class Cli : public ::testing::Test {
+class Cli : public test::CliTest {
 protected:
-    fs::path dir_;
-    fs::path sample_ = test::bundled_data() / "ecd/shapes_translation/events.txt";
     fs::path golden_ = test::bundled_data() / "ecd/shapes_translation/efast.golden.idx";
-
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               (std::string("evcorner-cli-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    // Runs "evcorner ARGS" through the shell from dir_, capturing both streams.
-    Result run(const std::string& args, const std::string& stdin_from = "/dev/null") {
-        const std::string cmd = "cd '" + dir_.string() + "' && '" EVCORNER_CLI "' " + args + " <" + stdin_from +
-                                " >out.stdout 2>out.stderr";
-        const int raw = std::system(cmd.c_str());
-        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir_ / "out.stdout"), slurp(dir_ / "out.stderr")};
-    }
-    std::string write(const std::string& name, const std::string& content) {
-        std::ofstream(dir_ / name, std::ios::binary) << content;
-        return (dir_ / name).string();
-    }
 };
 
 TEST_F(Cli, DetectWritesCornersMaskAndSummary) {

@@ -2,54 +2,23 @@
 
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
-#include "test_util.hpp"
+#include "cli_test_util.hpp"
 
 namespace evcorner {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-    int status;
-    std::string out;
-    std::string err;
-};
+using Result = test::CliResult;
+using test::slurp;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-class CliBench : public ::testing::Test {
-protected:
-    fs::path dir_;
-    fs::path sample_ = test::bundled_data() / "ecd/shapes_translation/events.txt";
-
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               (std::string("evcorner-cli-bench-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    Result run(const std::string& args) {
-        const std::string cmd = "cd '" + dir_.string() + "' && '" EVCORNER_CLI "' " + args +
-                                " </dev/null >out.stdout 2>out.stderr";
-        const int raw = std::system(cmd.c_str());
-        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir_ / "out.stdout"), slurp(dir_ / "out.stderr")};
-    }
-};
+class CliBench : public test::CliTest {};
 
 TEST_F(CliBench, PrintsTheTableAndWritesJson) {
     const Result r = run("bench '" + sample_.string() +

@@ -2,27 +2,19 @@
 
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 
-#include "test_util.hpp"
+#include "cli_test_util.hpp"
 
 namespace evcorner {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using test::slurp;
 
 // Width and height from a PNG's IHDR chunk; (0, 0) when it is not a PNG.
 std::pair<unsigned, unsigned> png_size(const fs::path& p) {
@@ -35,32 +27,21 @@ std::pair<unsigned, unsigned> png_size(const fs::path& p) {
     return {be32(16), be32(20)};
 }
 
-class CliEval : public ::testing::Test {
+class CliEval : public test::CliTest {
 protected:
-    fs::path dir_;
-    fs::path sample_ = test::bundled_data() / "ecd/shapes_translation/events.txt";
-
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               (std::string("evcorner-clieval-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    int run(const std::string& args, std::string* err = nullptr) {
-        const std::string cmd = "cd '" + dir_.string() + "' && '" EVCORNER_CLI "' " + args + " >out.stdout 2>out.stderr";
-        const int raw = std::system(cmd.c_str());
-        if (err) *err = slurp(dir_ / "out.stderr");
-        return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    // The exit status of "evcorner ARGS"; its standard error into *err when given.
+    int run_status(const std::string& args, std::string* err = nullptr) {
+        const test::CliResult r = run(args);
+        if (err) *err = r.err;
+        return r.status;
     }
 };
 
 TEST_F(CliEval, LabelWritesOneLabelPerCornerAndTheFtShare) {
-    ASSERT_EQ(run("detect '" + sample_.string() + "' -q -o corners.txt"), 0);
+    ASSERT_EQ(run_status("detect '" + sample_.string() + "' -q -o corners.txt"), 0);
     const std::size_t corners = test::read_index_file(test::bundled_data() / "ecd/shapes_translation/efast.golden.idx").size();
     std::string err;
-    ASSERT_EQ(run("label corners.txt -o labels.txt --json l.json", &err), 0) << err;
+    ASSERT_EQ(run_status("label corners.txt -o labels.txt --json l.json", &err), 0) << err;
     std::ifstream in(dir_ / "labels.txt");
     std::size_t lines = 0, ones = 0;
     for (std::string l; std::getline(in, l); ++lines) {
@@ -80,7 +61,7 @@ TEST_F(CliEval, LabelWritesOneLabelPerCornerAndTheFtShare) {
 
 TEST_F(CliEval, EvalWritesBothTablesAndTheReport) {
     std::string err;
-    ASSERT_EQ(run("eval '" + (test::bundled_data() / "ecd").string() + "' -d efast,harris --repeat 1 -q --report rep",
+    ASSERT_EQ(run_status("eval '" + (test::bundled_data() / "ecd").string() + "' -d efast,harris --repeat 1 -q --report rep",
                   &err),
               0)
         << err;
@@ -111,7 +92,7 @@ TEST_F(CliEval, EvalWritesBothTablesAndTheReport) {
 TEST_F(CliEval, RenderEveryKindAsPng) {
     for (const std::string kind : {"sae", "corners", "space-time", "labels"}) {
         std::string err;
-        ASSERT_EQ(run("render '" + sample_.string() + "' -k " + kind + " -o " + kind + ".png", &err), 0) << kind << err;
+        ASSERT_EQ(run_status("render '" + sample_.string() + "' -k " + kind + " -o " + kind + ".png", &err), 0) << kind << err;
         const auto [w, h] = png_size(dir_ / (kind + ".png"));
         EXPECT_GT(w, 0u) << kind;
         EXPECT_GT(h, 0u) << kind;
@@ -121,8 +102,8 @@ TEST_F(CliEval, RenderEveryKindAsPng) {
         }
     }
     std::string err;
-    EXPECT_NE(run("render '" + sample_.string() + "' -k nonsense -o x.png", &err), 0);
-    EXPECT_NE(run("render no-such-file.txt -o x.png", &err), 0);
+    EXPECT_NE(run_status("render '" + sample_.string() + "' -k nonsense -o x.png", &err), 0);
+    EXPECT_NE(run_status("render no-such-file.txt -o x.png", &err), 0);
     EXPECT_NE(err.find("no-such-file.txt"), std::string::npos) << err;
 }
 
