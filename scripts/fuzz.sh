@@ -31,7 +31,7 @@ seed text fuzz/seeds/seed.txt data/ecd/*/events.txt "$shared"/ecd-stppp/shapes_r
 seed csv fuzz/seeds/seed.csv
 seed npy fuzz/seeds/seed.npy
 seed hdf5 fuzz/seeds/*.h5
-seed aedat4 fuzz/seeds/seed.aedat4 "$shared"/*/*.aedat4
+seed aedat4 fuzz/seeds/*.aedat4 "$shared"/*/*.aedat4
 seed aedat2 "$shared"/davis240c-imu-pyaedattools/*.aedat "$shared"/dvs128-walking-ouyang/neal_walking.aedat
 seed evt2 "$shared"/expelliarmus/evt2_sample.raw "$shared"/faery-testdata/evt2.raw
 seed evt3 "$shared"/expelliarmus/evt3_sample.raw

@@ -175,7 +175,7 @@ void Aedat4Reader::decompress(const unsigned char* src, std::size_t size) {
     decoded_size_ = 0;
     if (compression_ == Compression::none) {
         decoded_.resize(std::max(decoded_.size(), size));
-        std::memcpy(decoded_.data(), src, size);
+        if (size > 0) std::memcpy(decoded_.data(), src, size);  // an empty vector's data() may be null
         decoded_size_ = size;
         return;
     }
