@@ -39,7 +39,7 @@ void OutputFile::write(std::string_view bytes) {
         flush();
         if (bytes.size() > buf_.size()) buf_.resize(bytes.size());
     }
-    std::memcpy(buf_.data() + used_, bytes.data(), bytes.size());
+    if (!bytes.empty()) std::memcpy(buf_.data() + used_, bytes.data(), bytes.size());  // data() may be null
     used_ += bytes.size();
 }
 
