@@ -10,10 +10,6 @@ namespace {
 
 constexpr std::size_t kRecord = 8;
 
-inline std::uint32_t be32(const unsigned char* p) noexcept {
-    return std::uint32_t{p[0]} << 24 | std::uint32_t{p[1]} << 16 | std::uint32_t{p[2]} << 8 | p[3];
-}
-
 std::string trim(std::string s) {
     auto sp = [](unsigned char c) { return std::isspace(c) != 0; };
     s.erase(s.begin(), std::find_if_not(s.begin(), s.end(), sp));
@@ -85,17 +81,14 @@ Aedat2Reader::Aedat2Reader(std::string path, ReaderOptions options)
 }
 
 bool Aedat2Reader::decode() {
-    std::size_t avail = fill(kRecord);
-    if (avail < kRecord) {
-        if (avail == 0) return false;
-        fail(offset(), fmt::format("the file ends inside an event record ({} of {} bytes)", avail, kRecord));
-    }
-    const std::size_t records = std::min(avail / kRecord, batch_room());
+    const std::size_t available = whole_records(kRecord, "an event record");
+    if (available == 0) return false;
+    const std::size_t records = std::min(available, batch_room());
     const unsigned char* p = data();
     const std::uint64_t base = offset();
     for (std::size_t i = 0; i < records; ++i, p += kRecord) {
-        const std::uint32_t a = be32(p);
-        const std::uint32_t raw = be32(p + 4);
+        const std::uint32_t a = load_be32(p);
+        const std::uint32_t raw = load_be32(p + 4);
         const std::int64_t t = unwrap_(raw);
         if (layout_ == Layout::davis) {
             if ((a & 0x8000'0400u) != 0) {

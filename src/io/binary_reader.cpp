@@ -26,6 +26,13 @@ void BinaryReader::set_file_sensor(std::optional<SensorSize> from_file) noexcept
     limit_h_ = static_cast<std::uint32_t>(h);
 }
 
+std::size_t BinaryReader::whole_records(std::size_t bytes, std::string_view what) {
+    const std::size_t avail = fill(bytes);
+    if (avail > 0 && avail < bytes)
+        fail(offset(), fmt::format("the file ends inside {} ({} of {} bytes)", what, avail, bytes));
+    return avail / bytes;
+}
+
 std::size_t BinaryReader::fill(std::size_t want) {
     while (fill_ - pos_ < want && !eof_) {
         if (pos_ > 0) {

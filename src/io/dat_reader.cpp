@@ -9,9 +9,6 @@ namespace evcorner::io {
 
 namespace {
 constexpr std::size_t kRecord = 8;
-inline std::uint32_t le32(const unsigned char* p) noexcept {
-    return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
-}
 }  // namespace
 
 DatReader::DatReader(std::string path, ReaderOptions options) : BinaryReader(std::move(path), options) {
@@ -33,17 +30,14 @@ DatReader::DatReader(std::string path, ReaderOptions options) : BinaryReader(std
 }
 
 bool DatReader::decode() {
-    const std::size_t avail = fill(kRecord);
-    if (avail < kRecord) {
-        if (avail == 0) return false;
-        fail(offset(), fmt::format("the file ends inside an event record ({} of {} bytes)", avail, kRecord));
-    }
-    const std::size_t records = std::min(avail / kRecord, batch_room());
+    const std::size_t available = whole_records(kRecord, "an event record");
+    if (available == 0) return false;
+    const std::size_t records = std::min(available, batch_room());
     const unsigned char* p = data();
     const std::uint64_t base = offset();
     for (std::size_t i = 0; i < records; ++i, p += kRecord) {
-        const std::uint32_t raw = le32(p);
-        const std::uint32_t d = le32(p + 4);
+        const std::uint32_t raw = load_le32(p);
+        const std::uint32_t d = load_le32(p + 4);
         const std::int64_t t = unwrap_(raw);
         const std::uint32_t pol = d >> 28;
         if (pol > 1) [[unlikely]] {

@@ -9,9 +9,6 @@ namespace evcorner::io {
 
 namespace {
 constexpr std::size_t kWord = 4;
-inline std::uint32_t le32(const unsigned char* p) noexcept {
-    return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
-}
 }  // namespace
 
 Evt2Reader::Evt2Reader(std::string path, ReaderOptions options) : BinaryReader(std::move(path), options) {
@@ -25,16 +22,13 @@ Evt2Reader::Evt2Reader(std::string path, ReaderOptions options) : BinaryReader(s
 }
 
 bool Evt2Reader::decode() {
-    const std::size_t avail = fill(kWord);
-    if (avail < kWord) {
-        if (avail == 0) return false;
-        fail(offset(), fmt::format("the file ends inside a 32-bit word ({} of 4 bytes)", avail));
-    }
-    const std::size_t words = std::min(avail / kWord, batch_room());
+    const std::size_t available = whole_records(kWord, "a 32-bit word");
+    if (available == 0) return false;
+    const std::size_t words = std::min(available, batch_room());
     const unsigned char* p = data();
     const std::uint64_t base = offset();
     for (std::size_t i = 0; i < words; ++i, p += kWord) {
-        const std::uint32_t w = le32(p);
+        const std::uint32_t w = load_le32(p);
         const std::uint32_t type = w >> 28;
         if (type <= 1) {
             if (time_high_ < 0) [[unlikely]]

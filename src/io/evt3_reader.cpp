@@ -35,17 +35,13 @@ bool Evt3Reader::drain_vector() {
 
 bool Evt3Reader::decode() {
     if (!drain_vector()) return true;
-    const std::size_t avail = fill(kWord);
-    if (avail < kWord) {
-        if (avail == 0) return false;
-        fail(offset(), "the file ends inside a 16-bit word (1 of 2 bytes)");
-    }
-    const std::size_t words = avail / kWord;
+    const std::size_t words = whole_records(kWord, "a 16-bit word");
+    if (words == 0) return false;
     const unsigned char* p = data();
     const std::uint64_t base = offset();
     std::size_t i = 0;
     for (; i < words && !batch_full(); ++i, p += kWord) {
-        const std::uint32_t w = std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8;
+        const std::uint32_t w = load_le16(p);
         const std::uint64_t at = base + i * kWord;
         switch (w >> 12) {
             case 0x0:

@@ -16,13 +16,14 @@
 #include <optional>
 #include <string_view>
 
+#include "evcorner/io/byte_order.hpp"
+
 namespace evcorner::io::fb {
 
-inline std::uint16_t u16(const unsigned char* p) noexcept { return static_cast<std::uint16_t>(p[0] | p[1] << 8); }
-inline std::uint32_t u32(const unsigned char* p) noexcept {
-    return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
-}
-inline std::uint64_t u64(const unsigned char* p) noexcept { return u32(p) | std::uint64_t{u32(p + 4)} << 32; }
+// FlatBuffers are little-endian.
+inline std::uint16_t u16(const unsigned char* p) noexcept { return load_le16(p); }
+inline std::uint32_t u32(const unsigned char* p) noexcept { return load_le32(p); }
+inline std::uint64_t u64(const unsigned char* p) noexcept { return load_le64(p); }
 
 class Buffer {
 public:

@@ -19,6 +19,7 @@
 
 #include "evcorner/error.hpp"
 #include "evcorner/event.hpp"
+#include "evcorner/io/byte_order.hpp"
 #include "evcorner/io/event_reader.hpp"
 #include "evcorner/io/input_file.hpp"
 #include "evcorner/sensor.hpp"
@@ -74,6 +75,10 @@ protected:
     // -- the byte buffer
     /// Makes at least `want` bytes available (fewer only at end of file); returns how many are.
     std::size_t fill(std::size_t want);
+    /// The whole records of `bytes` bytes each available now (at least one unless the
+    /// file has ended: 0 then). A file that ends inside a record is an error at its
+    /// offset: "the file ends inside `what` (k of `bytes` bytes)".
+    std::size_t whole_records(std::size_t bytes, std::string_view what);
     [[nodiscard]] const unsigned char* data() const noexcept {
         return reinterpret_cast<const unsigned char*>(buf_.data()) + pos_;
     }
