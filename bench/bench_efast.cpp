@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
             per_file(s, *ev,
                      [] {
                          return std::make_unique<ParallelDetector<EFast>>(kDavis240, 2, kCircleMargin,
-                                                                          [] { return EFast(kDavis240); });
+                                                                          [](SensorSize s) { return EFast(s); });
                      },
                      [](ParallelDetector<EFast>& d, const std::vector<Event>& e, std::vector<std::uint8_t>& f) {
                          return d.detect(e, f);

@@ -87,46 +87,49 @@ void WorkerPool::run(const std::function<void(int)>& job) {
     }
 }
 
-std::vector<DetectPart> plan_parts(SensorSize size, int threads, std::span<const Event> sample) {
-    threads = std::max(1, threads);
+std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::span<const Event> sample) {
     const int h = size.height;
-    // Cell c = p * h + y: OFF rows first, then ON rows; its share of the sample.
-    std::vector<std::uint64_t> count(2 * static_cast<std::size_t>(h), 0);
-    std::uint64_t total = 0;
-    for (const Event& e : sample)
-        if (e.y < h) {
-            ++count[static_cast<std::size_t>((e.p & 1) * h + e.y)];
-            ++total;
-        }
-    const int cells = 2 * h;
+    const int min_rows = std::max(1, 2 * radius);
+    bands = std::clamp(bands, 1, std::max(1, h / min_rows));
     std::vector<DetectPart> parts;
-    int c = 0;
-    std::uint64_t cum = 0;
-    for (int t = 0; t < threads; ++t) {
-        int end = cells;
-        if (t + 1 < threads) {
-            if (total == 0) {
-                end = static_cast<int>(static_cast<std::int64_t>(cells) * (t + 1) / threads);
-            } else {
-                // The run ends where the cumulative count comes closest to (t+1)/threads.
-                const std::uint64_t target = total * static_cast<std::uint64_t>(t + 1) / static_cast<std::uint64_t>(threads);
-                end = c;
-                while (end < cells && cum + count[static_cast<std::size_t>(end)] <= target) cum += count[static_cast<std::size_t>(end++)];
-                if (end < cells && target - cum > cum + count[static_cast<std::size_t>(end)] - target)
-                    cum += count[static_cast<std::size_t>(end++)];
+    for (int p = 0; p < 2; ++p) {
+        // Rows' shares of this polarity's sample events.
+        std::vector<std::uint64_t> count(static_cast<std::size_t>(h), 0);
+        std::uint64_t total = 0;
+        for (const Event& e : sample)
+            if ((e.p & 1) == p && e.y < h) {
+                ++count[e.y];
+                ++total;
             }
-            end = std::max(c, end);
+        int y = 0;
+        std::uint64_t cum = 0;
+        for (int b = 0; b < bands; ++b) {
+            int end = h;
+            if (b + 1 < bands) {
+                if (total == 0) {
+                    end = static_cast<int>(static_cast<std::int64_t>(h) * (b + 1) / bands);
+                } else {
+                    // The band ends where the cumulative count comes closest to (b+1)/bands.
+                    const std::uint64_t target = total * static_cast<std::uint64_t>(b + 1) / static_cast<std::uint64_t>(bands);
+                    end = y;
+                    while (end < h && cum + count[static_cast<std::size_t>(end)] <= target) cum += count[static_cast<std::size_t>(end++)];
+                    if (end < h && target - cum > cum + count[static_cast<std::size_t>(end)] - target)
+                        cum += count[static_cast<std::size_t>(end++)];
+                }
+                // At least min_rows rows for this band and for each band after it.
+                end = std::clamp(end, y + min_rows, h - (bands - b - 1) * min_rows);
+                cum = 0;
+                for (int r = 0; r < end; ++r) cum += count[static_cast<std::size_t>(r)];
+            }
+            DetectPart part;
+            part.p = p;
+            part.y0 = y;
+            part.y1 = end;
+            part.lo = std::max(0, y - radius);
+            part.hi = std::min(h, end + radius);
+            parts.push_back(part);
+            y = end;
         }
-        // Cells [c, end) as a band per polarity.
-        DetectPart part;
-        for (int p = 0; p < 2; ++p) {
-            const int from = std::clamp(c - p * h, 0, h);
-            const int to = std::clamp(end - p * h, 0, h);
-            part.y0[p] = from < to ? from : 0;
-            part.y1[p] = from < to ? to : 0;
-        }
-        parts.push_back(part);
-        c = end;
     }
     return parts;
 }

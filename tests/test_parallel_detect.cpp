@@ -1,5 +1,6 @@
 // Parallel detection: identical flags, in input order, to one detector on one thread,
-// for 1..4 threads, on random HD streams and on the bundled sample.
+// for 1..4 threads and 1..3 parts per thread, on random HD streams, small sensors and
+// the bundled sample; batches queued ahead (prepare/run) as evcorner detect does.
 
 #include <gtest/gtest.h>
 
@@ -51,25 +52,47 @@ std::vector<Event> random_stream(SensorSize s, std::size_t n, std::uint32_t seed
 template <class D, class Make>
 void expect_same_as_one_thread(const std::vector<Event>& events, SensorSize s, int radius, Make make,
                                std::size_t batch, bool need_corners = true) {
-    D one = make();
+    D one = make(s);
     std::vector<std::uint8_t> expected(events.size());
     const std::size_t corners = detect(one, std::span<const Event>(events), expected);
     if (need_corners) {
         ASSERT_GT(corners, 0u);  // else the comparison is empty
     }
-    for (int threads = 1; threads <= 4; ++threads) {
-        SCOPED_TRACE(threads);
-        ParallelDetector<D> par(s, threads, radius, make);
-        std::vector<std::uint8_t> got(events.size(), 7);
-        std::size_t c = 0;
-        // In batches, as evcorner detect reads them: the state carries over.
-        for (std::size_t at = 0; at < events.size(); at += batch) {
-            const std::size_t n = std::min(batch, events.size() - at);
-            c += par.detect(std::span<const Event>(events).subspan(at, n), std::span<std::uint8_t>(got).subspan(at, n));
+    for (int threads = 1; threads <= 4; ++threads)
+        for (int per_thread = 1; per_thread <= 3; ++per_thread) {
+            SCOPED_TRACE(testing::Message() << threads << " threads, " << per_thread << " parts per thread");
+            {
+                // detect() over batches, as evcorner bench does: the state carries over.
+                ParallelDetector<D> par(s, threads, radius, make, per_thread);
+                std::vector<std::uint8_t> got(events.size(), 7);
+                std::size_t c = 0;
+                for (std::size_t at = 0; at < events.size(); at += batch) {
+                    const std::size_t n = std::min(batch, events.size() - at);
+                    c += par.detect(std::span<const Event>(events).subspan(at, n), std::span<std::uint8_t>(got).subspan(at, n));
+                }
+                EXPECT_EQ(c, corners);
+                for (std::size_t i = 0; i < events.size(); ++i) ASSERT_EQ(got[i], expected[i]) << "event " << i;
+            }
+            if (threads == 1) continue;  // one thread: detect() only
+            {
+                // prepare() of batch k + 1 alongside run() of batch k, as evcorner detect does.
+                ParallelDetector<D> par(s, threads, radius, make, per_thread);
+                const std::size_t step = std::min(batch, ParallelDetector<D>::kMaxBatch);
+                std::vector<std::uint8_t> got(events.size(), 7);
+                std::size_t c = 0;
+                par.prepare(std::span<const Event>(events).first(std::min(step, events.size())));
+                for (std::size_t at = 0; at < events.size(); at += step) {
+                    const std::size_t n = std::min(step, events.size() - at);
+                    const std::size_t next = at + n;
+                    c += par.run(std::span<std::uint8_t>(got).subspan(at, n), [&] {
+                        if (next < events.size())
+                            par.prepare(std::span<const Event>(events).subspan(next, std::min(step, events.size() - next)));
+                    });
+                }
+                EXPECT_EQ(c, corners);
+                for (std::size_t i = 0; i < events.size(); ++i) ASSERT_EQ(got[i], expected[i]) << "event " << i;
+            }
         }
-        EXPECT_EQ(c, corners);
-        for (std::size_t i = 0; i < events.size(); ++i) ASSERT_EQ(got[i], expected[i]) << "event " << i;
-    }
 }
 
 TEST(ParallelDetect, EFastRandomHdStreams) {
@@ -77,51 +100,80 @@ TEST(ParallelDetect, EFastRandomHdStreams) {
     for (std::uint32_t seed = 1; seed <= 3; ++seed) {
         SCOPED_TRACE(seed);
         const auto events = random_stream(hd, 300000, seed);
-        expect_same_as_one_thread<EFast>(events, hd, kCircleMargin, [&] { return EFast(hd); }, 70000);
+        expect_same_as_one_thread<EFast>(events, hd, kCircleMargin, [](SensorSize z) { return EFast(z); }, 70000);
     }
 }
 
 TEST(ParallelDetect, EFastSmallSensors) {
     for (const SensorSize s : {SensorSize{9, 9}, SensorSize{17, 11}, SensorSize{64, 48}}) {
         const auto events = random_stream(s, 40000, 11);
-        expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [&] { return EFast(s); }, 4096,
+        expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [](SensorSize z) { return EFast(z); }, 4096,
                                          /*need_corners=*/s.width > 32);
     }
 }
 
 TEST(ParallelDetect, EFastBundledSample) {
     const auto events = io::read_text_file((test::bundled_data() / "ecd/shapes_translation/events.txt").string());
-    expect_same_as_one_thread<EFast>(events, kDavis240, kCircleMargin, [] { return EFast(kDavis240); }, 1 << 16);
+    expect_same_as_one_thread<EFast>(events, kDavis240, kCircleMargin, [](SensorSize z) { return EFast(z); }, 1 << 16);
 }
 
 TEST(ParallelDetect, HarrisRandomHdStream) {
     const SensorSize hd{1280, 720};
     const auto events = random_stream(hd, 40000, 5);
-    expect_same_as_one_thread<Harris>(events, hd, HarrisParams{}.window / 2, [&] { return Harris(hd); }, 9000);
+    expect_same_as_one_thread<Harris>(events, hd, HarrisParams{}.window / 2, [](SensorSize z) { return Harris(z); }, 9000);
 }
 
-TEST(ParallelDetect, TwoPartsSplitTheSampleInHalf) {
+TEST(ParallelDetect, BandsSplitEachPolarityEvenly) {
     const SensorSize hd{1280, 720};
     const auto events = random_stream(hd, 50000, 9);
-    const auto parts = plan_parts(hd, 2, events);
-    std::size_t first = 0;
-    for (const Event& e : events) first += parts[0].owns(e.p, e.y);
-    EXPECT_NEAR(static_cast<double>(first) / static_cast<double>(events.size()), 0.5, 0.01);
+    const auto parts = plan_parts(hd, 2, kCircleMargin, events);
+    ASSERT_EQ(parts.size(), 4u);
+    for (int p = 0; p < 2; ++p) {
+        std::size_t in_first = 0, of_p = 0;
+        for (const Event& e : events) {
+            of_p += e.p == p;
+            in_first += parts[2 * static_cast<std::size_t>(p)].owns(e.p, e.y);
+        }
+        EXPECT_NEAR(static_cast<double>(in_first) / static_cast<double>(of_p), 0.5, 0.01) << "polarity " << p;
+    }
 }
 
-TEST(ParallelDetect, PartsCoverTheSensorOnce) {
-    const SensorSize hd{1280, 720};
-    const auto events = random_stream(hd, 20000, 3);
-    for (int threads = 1; threads <= 8; ++threads) {
-        const auto parts = plan_parts(hd, threads, events);
-        ASSERT_EQ(static_cast<int>(parts.size()), threads);
-        for (int p = 0; p < 2; ++p)
-            for (int y = 0; y < hd.height; ++y) {
-                int owners = 0;
-                for (const auto& part : parts) owners += part.owns(p, y);
-                ASSERT_EQ(owners, 1) << threads << " threads, polarity " << p << ", row " << y;
+TEST(ParallelDetect, PartsCoverTheSensorOnceWithHalos) {
+    for (const SensorSize s : {SensorSize{1280, 720}, SensorSize{240, 180}, SensorSize{17, 11}, SensorSize{9, 9}}) {
+        const auto events = random_stream(s, 20000, 3);
+        for (int bands = 1; bands <= 40; ++bands) {
+            const int radius = 4;
+            const auto parts = plan_parts(s, bands, radius, events);
+            ASSERT_GE(parts.size(), 2u);
+            ASSERT_LE(parts.size(), 2u * static_cast<std::size_t>(bands));
+            for (const auto& part : parts) {
+                // A band is at least 2r rows high (or the whole sensor), its halo r rows
+                // on each side, clipped to the sensor.
+                EXPECT_TRUE(part.y1 - part.y0 >= 2 * radius || (part.y0 == 0 && part.y1 == s.height));
+                EXPECT_EQ(part.lo, std::max(0, part.y0 - radius));
+                EXPECT_EQ(part.hi, std::min(s.height, part.y1 + radius));
             }
+            for (int p = 0; p < 2; ++p)
+                for (int y = 0; y < s.height; ++y) {
+                    int owners = 0;
+                    for (const auto& part : parts) owners += part.owns(p, y);
+                    ASSERT_EQ(owners, 1) << s.width << "x" << s.height << ", " << bands << " bands, polarity " << p << ", row " << y;
+                }
+        }
     }
+}
+
+TEST(ParallelDetect, AnErrorAlongsideComesAfterTheBatch) {
+    const SensorSize s{64, 48};
+    const auto events = random_stream(s, 5000, 4);
+    EFast one(s);
+    std::vector<std::uint8_t> expected(events.size());
+    detect(one, std::span<const Event>(events), expected);
+    ParallelDetector<EFast> par(s, 2, kCircleMargin, [](SensorSize z) { return EFast(z); });
+    par.prepare(events);
+    std::vector<std::uint8_t> got(events.size(), 7);
+    EXPECT_THROW(par.run(got, [] { throw std::runtime_error("read failed"); }), std::runtime_error);
+    EXPECT_EQ(got, expected);  // the batch itself was detected in full
 }
 
 }  // namespace

@@ -4,26 +4,33 @@
 // A detector is *local* with radius r when whether event e is a corner depends only on
 // the earlier events of e's polarity within r pixels of e (eFAST: r = 4, the radius-4
 // circle; Harris: half its window). Then the sensor splits into parts, each a band of
-// rows [y0[p], y1[p]) per polarity p: the thread of a part keeps its own detector, feeds
-// it, in input order, every event of polarity p in rows [y0[p] - r, y1[p] + r) (the band
-// and its halo), and keeps its answers only for the events of its bands. Each event is classified
-// by exactly one part, from a state identical to that of a single detector run over the
-// whole stream, so the flags are identical, in input order, for any number of threads.
+// rows [y0, y1) of one polarity p: a part keeps its own detector, over a sensor of just
+// the rows [y0 - r, y1 + r) (the band and its halo, clipped to the sensor), feeds it, in
+// input order, every event of polarity p in those rows, and keeps its answers only for
+// the events of its band. Each event is classified by exactly one part, from a state
+// identical to that of a single detector run over the whole stream (the border rule
+// sees the same distances: a halo is at least the detector's border margin), so the flags
+// are identical, in input order, for any number of threads.
 //
-// Parts: the (polarity, row) cells, OFF rows then ON rows, cut into runs holding similar
-// numbers of the first batch's events (so two threads get OFF and ON split exactly in
-// half, although ON and OFF events are rarely half and half); fixed from then on (each
-// part's state only covers its bands and halos).
+// Parts outnumber threads (by default two per thread) and are handed out per batch,
+// largest first, to whichever thread is free: the load balances however the events move
+// over the sensor, and the calling thread can do other work first (read the next batch:
+// see run()). Bands are cut from the first batch, fixed from then on, each at least 2r
+// rows high, so that a row lies in the halo of at most one other band.
 //
-// Threads, clocks and allocation stay outside the detectors: detect() below is the
-// batch loop of detector.hpp, run by each thread on its share.
+// Threads, clocks and allocation stay outside the detectors: each part runs the
+// detector's own batch loop (detector.hpp; eFAST's fastest path from efast.hpp).
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
+#include <numeric>
 #include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "evcorner/detector.hpp"
@@ -50,19 +57,19 @@ private:
     std::unique_ptr<State> state_;
 };
 
-/// One part of the sensor: for each polarity p, the band of rows [y0[p], y1[p]) it owns
-/// (empty when y0[p] == y1[p]).
+/// One part of the sensor: the band of rows [y0, y1) of polarity p, and the rows
+/// [lo, hi) its detector covers (the band and its halo, clipped to the sensor).
 struct DetectPart {
-    int y0[2] = {0, 0};
-    int y1[2] = {0, 0};
-    [[nodiscard]] bool owns(int p, int y) const noexcept { return y >= y0[p] && y < y1[p]; }
+    int p = 0;
+    int y0 = 0, y1 = 0;
+    int lo = 0, hi = 0;
+    [[nodiscard]] bool owns(int pol, int y) const noexcept { return pol == p && y >= y0 && y < y1; }
 };
 
-/// Splits `size` into `threads` parts with similar numbers of `sample`'s events: the
-/// (polarity, row) cells in the order OFF rows 0..H-1, then ON rows 0..H-1, cut into
-/// `threads` runs. A run holds one band of one polarity, or the end of OFF and the start
-/// of ON; no halo is needed between polarities.
-std::vector<DetectPart> plan_parts(SensorSize size, int threads, std::span<const Event> sample);
+/// Cuts each polarity's rows into at most `bands` bands holding similar numbers of
+/// `sample`'s events, each at least max(1, 2 * radius) rows high (fewer bands on a short
+/// sensor). Returns the OFF bands top to bottom, then the ON bands.
+std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::span<const Event> sample);
 
 namespace detail {
 // The detector's batch loop: an unqualified call, so that argument-dependent lookup
@@ -71,120 +78,229 @@ template <class D>
 std::size_t run_batch(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
     return detect(det, events, is_corner);
 }
+
+// A buffer of trivially copyable values whose pages are touched only where written.
+template <class T>
+struct RawBuffer {
+    std::unique_ptr<T[]> data;
+    void reserve(std::size_t n) {
+        if (!data) data.reset(new T[n]);  // default-initialised: no writes
+    }
+};
 }  // namespace detail
 
 template <Detector D>
 class ParallelDetector {
 public:
-    /// `make()` builds one detector (one per part); `radius` is the detector's locality.
+    /// Most events a prepare() takes at once.
+    static constexpr std::size_t kMaxBatch = std::size_t{1} << 16;
+
+    /// `make(SensorSize)` builds one detector for a part's rows; `radius` is the
+    /// detector's locality; `parts_per_thread` parts per thread are handed out per batch.
     template <class Make>
-    ParallelDetector(SensorSize size, int threads, int radius, Make make)
-        : size_(size), radius_(radius), pool_(std::max(1, threads)) {
-        for (int i = 0; i < pool_.size(); ++i) detectors_.push_back(std::make_unique<D>(make()));
-        shares_.resize(static_cast<std::size_t>(pool_.size()));
+    ParallelDetector(SensorSize size, int threads, int radius, Make make, int parts_per_thread = 2)
+        : size_(size), radius_(radius), parts_per_thread_(std::max(1, parts_per_thread)),
+          pool_(std::max(1, threads)), make_(std::move(make)) {
+        if (pool_.size() == 1) single_ = std::make_unique<D>(make_(size_));
     }
 
     [[nodiscard]] int threads() const noexcept { return pool_.size(); }
-    [[nodiscard]] std::span<const DetectPart> parts() const noexcept { return parts_; }
+    [[nodiscard]] std::span<const DetectPart> parts() const noexcept { return plan_; }
 
     /// Like detect(det, events, is_corner) for a single detector, continuing the stream.
+    /// With several threads, reading batch k + 1 of the span overlaps detecting batch k.
     std::size_t detect(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
-        if (pool_.size() == 1) return detail::run_batch(*detectors_[0], events, is_corner);
-        if (parts_.empty()) parts_ = plan_parts(size_, pool_.size(), events);
+        if (single_) return detail::run_batch(*single_, events, is_corner);
         std::size_t corners = 0;
-        for (std::size_t at = 0; at < events.size(); at += kChunk) {
-            const std::size_t n = std::min(kChunk, events.size() - at);
-            corners += detect_chunk(events.subspan(at, n), is_corner.subspan(at, n));
+        if (events.empty()) return 0;
+        prepare(events.first(std::min(kMaxBatch, events.size())));
+        for (std::size_t at = 0; at < events.size(); at += kMaxBatch) {
+            const std::size_t n = std::min(kMaxBatch, events.size() - at);
+            const std::size_t next = at + n;
+            corners += run(is_corner.subspan(at, n), [&] {
+                if (next < events.size()) prepare(events.subspan(next, std::min(kMaxBatch, events.size() - next)));
+            });
         }
+        return corners;
+    }
+
+    /// Queues the next batch (at most kMaxBatch events, kept alive by the caller until its
+    /// run() returns): sorts it out to the parts. At most two batches are queued; the
+    /// first batch plans the parts.
+    void prepare(std::span<const Event> events) {
+        if (events.size() > kMaxBatch) throw std::length_error("ParallelDetector::prepare: batch too large");
+        if (queued_ == 2) throw std::logic_error("ParallelDetector::prepare: two batches queued already");
+        if (plan_.empty()) make_parts(events);
+        Slot& s = slots_[(front_ + queued_) % 2];
+        scatter(events, s);
+        ++queued_;
+    }
+
+    /// Detects the oldest queued batch into `is_corner` (its size) and returns its number
+    /// of corners. `alongside` runs on the calling thread first, while the other threads
+    /// already detect (it may prepare() the next batch); then the calling thread helps.
+    /// An exception from `alongside` is rethrown once the batch is done.
+    std::size_t run(std::span<std::uint8_t> is_corner, const std::function<void()>& alongside = {}) {
+        if (single_) throw std::logic_error("ParallelDetector::run: one thread; use detect()");
+        if (queued_ == 0) throw std::logic_error("ParallelDetector::run: no batch prepared");
+        Slot& s = slots_[front_];
+        if (is_corner.size() != s.n) throw std::invalid_argument("ParallelDetector::run: flags size differs from the batch");
+        std::atomic<std::size_t> next{0};
+        std::exception_ptr failed;
+        pool_.run([&](int w) {
+            if (w == 0 && alongside) {
+                try {
+                    alongside();
+                } catch (...) {
+                    failed = std::current_exception();
+                }
+            }
+            for (std::size_t j; (j = next.fetch_add(1, std::memory_order_relaxed)) < s.order.size();)
+                run_part(s.order[j], s);
+        });
+        // Corners are sparse: set them here rather than have threads write bytes that
+        // share cache lines. Each event belongs to one part, so the order is the input's.
+        std::fill(is_corner.begin(), is_corner.end(), std::uint8_t{0});
+        std::size_t corners = 0;
+        for (const Part& part : parts_) {
+            for (std::size_t k = 0; k < part.found; ++k) is_corner[part.corners.data[k]] = 1;
+            corners += part.found;
+        }
+        front_ = (front_ + 1) % 2;
+        --queued_;
+        if (failed) std::rethrow_exception(failed);
         return corners;
     }
 
     /// Bytes of state over all parts.
     template <class MemoryOf>
     [[nodiscard]] std::size_t memory_bytes(MemoryOf memory_of) const {
+        if (single_) return memory_of(*single_);
         std::size_t b = 0;
-        for (const auto& d : detectors_) b += memory_of(*d);
+        for (const auto& part : parts_) b += memory_of(*part.detector);
         return b;
     }
 
 private:
-    // Events per round of the threads: bounds the per-thread buffers (25 bytes an event).
-    static constexpr std::size_t kChunk = std::size_t{1} << 16;
+    static constexpr std::uint32_t kHalo = std::uint32_t{1} << 31;  // in a position: halo event
 
-    std::size_t detect_chunk(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
-        const std::size_t n = events.size();
-        for (auto& sh : shares_) {
-            sh.seen.resize(n);
-            sh.events.resize(n);
-            sh.flags.resize(n);
-            sh.corners.resize(n);
-        }
-        pool_.run([&](int w) {
-            // Each thread clears its slice of the output, then runs its part.
-            const std::size_t parts = shares_.size();
-            const std::size_t from = n * static_cast<std::size_t>(w) / parts;
-            const std::size_t to = n * (static_cast<std::size_t>(w) + 1) / parts;
-            std::fill(is_corner.begin() + static_cast<std::ptrdiff_t>(from),
-                      is_corner.begin() + static_cast<std::ptrdiff_t>(to), std::uint8_t{0});
-            run_part(static_cast<std::size_t>(w), events);
-        });
-        // Corners are sparse: set them here rather than have threads write bytes that
-        // share cache lines. Each event belongs to one part, so the order is the input's.
-        std::size_t corners = 0;
-        for (const auto& sh : shares_) {
-            for (std::size_t k = 0; k < sh.found; ++k) is_corner[sh.corners[k]] = 1;
-            corners += sh.found;
-        }
-        return corners;
-    }
-
-    struct Share {
-        std::vector<std::uint32_t> seen;     // positions of the events this part must see
-        std::vector<Event> events;           // those events, in order
-        std::vector<std::uint8_t> flags;     // the detector's answers for them
-        std::vector<std::uint32_t> corners;  // positions of the corners of its band
+    struct Part {
+        std::unique_ptr<D> detector;
+        int lo = 0;
+        detail::RawBuffer<std::uint8_t> flags;
+        detail::RawBuffer<std::uint32_t> corners;  // positions of the corners of its band
         std::size_t found = 0;
     };
+    // One batch, sorted out to the parts.
+    struct Slot {
+        std::size_t n = 0;
+        std::vector<detail::RawBuffer<Event>> events;      // the part's events, rows shifted by lo
+        std::vector<detail::RawBuffer<std::uint32_t>> at;  // their positions in the batch (| kHalo)
+        std::vector<std::uint32_t> count;
+        std::vector<std::uint32_t> order;  // parts with events, largest first
+    };
 
-    void run_part(std::size_t w, std::span<const Event> events) noexcept {
-        const DetectPart part = parts_[w];
-        Share& s = shares_[w];
-        // Rows to see per polarity: the band and its halo, or nothing.
-        int lo[2], hi[2];
-        for (int p = 0; p < 2; ++p) {
-            const bool empty = part.y0[p] >= part.y1[p];
-            lo[p] = empty ? 0 : part.y0[p] - radius_;
-            hi[p] = empty ? 0 : part.y1[p] + radius_;
+    void make_parts(std::span<const Event> sample) {
+        const int bands = std::clamp(pool_.size() * parts_per_thread_ / 2, 1, 256);
+        plan_ = plan_parts(size_, bands, radius_, sample);
+        const std::size_t P = plan_.size();
+        const std::size_t H = static_cast<std::size_t>(size_.height);
+        main_of_.assign(2 * H, 0);
+        halo_of_.assign(2 * H, static_cast<std::uint16_t>(P));  // P: in no halo
+        for (std::size_t j = 0; j < P; ++j) {
+            const DetectPart& d = plan_[j];
+            for (int y = d.y0; y < d.y1; ++y) main_of_[static_cast<std::size_t>(d.p) * H + static_cast<std::size_t>(y)] = static_cast<std::uint16_t>(j);
+            for (int y = d.lo; y < d.hi; ++y)
+                if (y < d.y0 || y >= d.y1) halo_of_[static_cast<std::size_t>(d.p) * H + static_cast<std::size_t>(y)] = static_cast<std::uint16_t>(j);
+            Part part;
+            part.detector = std::make_unique<D>(make_(SensorSize{size_.width, d.hi - d.lo}));
+            part.lo = d.lo;
+            part.flags.reserve(kMaxBatch);
+            part.corners.reserve(kMaxBatch);
+            parts_.push_back(std::move(part));
         }
-        // Branch-free selection of the events to see (polarity and rows are data and
-        // would mispredict).
-        std::size_t m = 0;
+        lo_.assign(P, 0);
+        for (std::size_t j = 0; j < P; ++j) lo_[j] = static_cast<std::uint16_t>(plan_[j].lo);
+        for (Slot& s : slots_) {
+            s.events.resize(P);
+            s.at.resize(P);
+            s.count.assign(P, 0);
+            for (auto& b : s.events) b.reserve(kMaxBatch);
+            for (auto& b : s.at) b.reserve(kMaxBatch);
+        }
+    }
+
+    // Each event to its band's part, and to the part whose halo holds it (if any): one
+    // pass. Branch-free for the band (rows and polarities are data and would mispredict);
+    // a branch for the halo, which few events are in (2r rows at each band boundary).
+    void scatter(std::span<const Event> events, Slot& s) {
+        const std::size_t P = parts_.size();
+        const std::size_t H = static_cast<std::size_t>(size_.height);
+        Event* out[512];
+        std::uint32_t* at[512];
+        std::uint32_t count[512] = {};
+        for (std::size_t j = 0; j < P; ++j) {
+            out[j] = s.events[j].data.get();
+            at[j] = s.at[j].data.get();
+        }
+        const std::uint16_t* main_of = main_of_.data();
+        const std::uint16_t* halo_of = halo_of_.data();
+        const std::uint16_t* lo = lo_.data();
         for (std::size_t i = 0; i < events.size(); ++i) {
             const Event& e = events[i];
-            s.seen[m] = static_cast<std::uint32_t>(i);
-            s.events[m] = e;
-            const int p = e.p & 1;
-            m += static_cast<unsigned>(e.y >= lo[p]) & static_cast<unsigned>(e.y < hi[p]);
+            const std::size_t cell = static_cast<std::size_t>(e.p & 1) * H + e.y;
+            const std::size_t a = main_of[cell];
+            Event ea = e;
+            ea.y = static_cast<std::uint16_t>(e.y - lo[a]);
+            out[a][count[a]] = ea;
+            at[a][count[a]++] = static_cast<std::uint32_t>(i);
+            const std::size_t b = halo_of[cell];
+            if (b < P) [[unlikely]] {
+                Event eb = e;
+                eb.y = static_cast<std::uint16_t>(e.y - lo[b]);
+                out[b][count[b]] = eb;
+                at[b][count[b]++] = static_cast<std::uint32_t>(i) | kHalo;
+            }
         }
-        // The detector's own batch loop (eFAST's fastest path) over them all; answers for
+        s.n = events.size();
+        s.order.clear();
+        for (std::size_t j = 0; j < P; ++j) {
+            s.count[j] = count[j];
+            if (count[j] > 0) s.order.push_back(static_cast<std::uint32_t>(j));
+        }
+        std::sort(s.order.begin(), s.order.end(), [&](std::uint32_t a, std::uint32_t b) { return s.count[a] > s.count[b]; });
+    }
+
+    void run_part(std::size_t j, const Slot& s) noexcept {
+        Part& part = parts_[j];
+        const std::size_t m = s.count[j];
+        const Event* ev = s.events[j].data.get();
+        const std::uint32_t* at = s.at[j].data.get();
+        std::uint8_t* flags = part.flags.data.get();
+        // The detector's own batch loop over band and halo events alike; answers for
         // halo events are dropped (a halo is a few rows).
-        detail::run_batch(*detectors_[w], std::span<const Event>(s.events.data(), m),
-                          std::span<std::uint8_t>(s.flags.data(), m));
+        detail::run_batch(*part.detector, std::span<const Event>(ev, m), std::span<std::uint8_t>(flags, m));
+        std::uint32_t* corners = part.corners.data.get();
         std::size_t found = 0;
         for (std::size_t k = 0; k < m; ++k) {
-            const Event& e = s.events[k];
-            s.corners[found] = s.seen[k];
-            found += s.flags[k] & static_cast<unsigned>(part.owns(e.p & 1, e.y));
+            corners[found] = at[k];
+            found += flags[k] & static_cast<unsigned>((at[k] & kHalo) == 0);
         }
-        s.found = found;
+        part.found = found;
     }
 
     SensorSize size_;
     int radius_;
+    int parts_per_thread_;
     WorkerPool pool_;
-    std::vector<std::unique_ptr<D>> detectors_;
-    std::vector<DetectPart> parts_;
-    std::vector<Share> shares_;
+    std::function<D(SensorSize)> make_;
+    std::unique_ptr<D> single_;
+    std::vector<DetectPart> plan_;
+    std::vector<Part> parts_;
+    std::vector<std::uint16_t> main_of_, halo_of_, lo_;  // per (polarity, row) cell; lo per part
+    Slot slots_[2];
+    int front_ = 0;   // the slot the next run() detects
+    int queued_ = 0;  // prepared batches not yet run
 };
 
 }  // namespace evcorner

@@ -147,18 +147,33 @@ bool NpyReader::decode() {
         static_cast<std::size_t>(std::min<std::uint64_t>({avail / itemsize_, batch_room(), declared_ - read_}));
     const unsigned char* p = data();
     const std::uint64_t base = offset();
-    for (std::size_t i = 0; i < records; ++i, p += itemsize_) {
+    const std::size_t size = itemsize_;
+    std::size_t i = 0;
+    while (i < records) {
+        // The common case: a run of valid records.
+        i += push_run(records - i, [&](std::size_t k, Event& e) {
+            const unsigned char* r = p + (i + k) * size;
+            std::memcpy(&e.t, r, 8);
+            std::memcpy(&e.x, r + 8, 2);
+            std::memcpy(&e.y, r + 10, 2);
+            e.p = r[12];
+        });
+        if (i == records) break;
+        // Record i failed a check: a polarity other than 0/1 is an error here, the rest
+        // push() reports or skips.
+        const unsigned char* r = p + i * size;
+        if (r[12] > 1) [[unlikely]] {
+            read_ += i;
+            consume(i * size);
+            fail(base + i * size + 12, fmt::format("polarity {} where 0 or 1 is expected", r[12]));
+        }
         std::int64_t t;
         std::uint16_t x, y;
-        std::memcpy(&t, p, 8);
-        std::memcpy(&x, p + 8, 2);
-        std::memcpy(&y, p + 10, 2);
-        if (p[12] > 1) [[unlikely]] {
-            read_ += i;
-            consume(i * itemsize_);
-            fail(base + i * itemsize_ + 12, fmt::format("polarity {} where 0 or 1 is expected", p[12]));
-        }
-        push(t, x, y, p[12] != 0, base + i * itemsize_);
+        std::memcpy(&t, r, 8);
+        std::memcpy(&x, r + 8, 2);
+        std::memcpy(&y, r + 10, 2);
+        push(t, x, y, r[12] != 0, base + i * size);
+        ++i;
     }
     read_ += records;
     consume(records * itemsize_);

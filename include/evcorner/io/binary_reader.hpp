@@ -108,6 +108,32 @@ protected:
                            static_cast<std::uint8_t>(on)};
     }
 
+    /// push() for `count` <= batch_room() records at once, for formats whose records
+    /// decode independently: decode(i, e) fills e from record i. Stops before the first record
+    /// that fails a check (outside the sensor, time going backwards, or p > 1) and returns
+    /// how many were pushed; the caller passes that one to push() (or fails), which skips
+    /// or reports it. The loop keeps its state in locals: stores to the events (a byte
+    /// field may alias anything) would otherwise reload the members every record.
+    template <class Decode>
+    std::size_t push_run(std::size_t count, Decode decode) {
+        Event* const out = out_.data() + n_;
+        const std::uint32_t lw = limit_w_, lh = limit_h_;
+        std::int64_t last = last_t_;
+        std::size_t i = 0;
+        for (; i < count; ++i) {
+            Event e;
+            decode(i, e);
+            const bool ok = (e.x < lw) & (e.y < lh) & (e.t >= last) & (e.p <= 1);
+            if (!ok) [[unlikely]]
+                break;
+            out[i] = e;
+            last = e.t;
+        }
+        n_ += i;
+        last_t_ = last;
+        return i;
+    }
+
     [[noreturn]] void fail(std::uint64_t at, const std::string& reason) const;
     [[nodiscard]] const ReaderOptions& options() const noexcept { return options_; }
 
