@@ -1,8 +1,10 @@
 // Micro-benchmark of eFAST's per-event path on the real 240x180 recordings: the nine
 // Event-Camera-Dataset cuts and the two DAVIS240C AEDAT 2.0 files. Each run processes a
 // file's events with a fresh detector (construction untimed); "ns_per_event" is the
-// figure to read. Variants: efast (detect(), the path chosen for this CPU), efast_portable
-// (the scalar loop every x86-64 runs), efast_x2 (two threads, parallel_detect.hpp).
+// figure to read. Variants: efast (detect(), the path chosen for this CPU), efast_<path>
+// for every code path this CPU runs (avx512, avx2, portable: the loop every x86-64
+// runs), efast_x2 (two threads, parallel_detect.hpp; its first batch plans the parts and
+// builds their detectors, which weighs on files this short).
 // Use --benchmark_repetitions=N --benchmark_report_aggregates_only=true for medians.
 
 #include <benchmark/benchmark.h>
@@ -84,12 +86,13 @@ int main(int argc, char** argv) {
                          return detect(d, std::span<const Event>(e), f);
                      });
         })->Unit(benchmark::kMicrosecond);
-        benchmark::RegisterBenchmark(("efast_portable/" + name).c_str(), [ev](benchmark::State& s) {
-            per_file(s, *ev, [] { return std::make_unique<EFast>(kDavis240); },
-                     [](EFast& d, const std::vector<Event>& e, std::vector<std::uint8_t>& f) {
-                         return d.run<ScalarSearch>(e, f);
-                     });
-        })->Unit(benchmark::kMicrosecond);
+        for (const std::string& path : efast_code_paths())
+            benchmark::RegisterBenchmark(("efast_" + path + "/" + name).c_str(), [ev, path](benchmark::State& s) {
+                per_file(s, *ev, [] { return std::make_unique<EFast>(kDavis240); },
+                         [&path](EFast& d, const std::vector<Event>& e, std::vector<std::uint8_t>& f) {
+                             return detect_on_path(path, d, std::span<const Event>(e), f);
+                         });
+            })->Unit(benchmark::kMicrosecond);
         benchmark::RegisterBenchmark(("efast_x2/" + name).c_str(), [ev](benchmark::State& s) {
             per_file(s, *ev,
                      [] {

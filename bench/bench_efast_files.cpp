@@ -3,7 +3,7 @@
 // no file's data or branch history is warm from its own previous pass), and every
 // pass's corners are checked against the golden index files. Prints per-file median
 // and minimum and the median over the files. Usage: bench_efast_files [PASSES=41]
-// (environment EVCORNER_EFAST_PATH=portable times the portable loop).
+// (environment EVCORNER_EFAST_PATH=portable, avx2 or avx512 times that loop).
 
 #include <algorithm>
 #include <chrono>

@@ -1,11 +1,14 @@
-// The batch loop of eFAST, compiled twice: portable, and for AVX2 (chosen once at run
-// time from the CPU's features). Both produce identical flags; tests hold them to the
-// oracle and the goldens.
+// The batch loop of eFAST, compiled three times: portable, for AVX2 and for AVX-512
+// (chosen once at run time from the CPU's features). All produce identical flags; tests
+// hold each one this CPU runs to the oracle and the goldens.
 
 #include "evcorner/efast.hpp"
 
 #include <cstdlib>
 #include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace evcorner {
 
@@ -22,28 +25,46 @@ std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span
                                                                std::span<std::uint8_t> is_corner) noexcept {
     return det.run<Avx2Search>(events, is_corner);
 }
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t detect_avx512(
+    EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    return det.run<Avx512Search>(events, is_corner);
+}
 #endif
 
 using Loop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
 
-struct Choice {
-    Loop loop;
+struct Path {
     const char* name;
+    Loop loop;
 };
 
-Choice choose() noexcept {
-    // EVCORNER_EFAST_PATH=portable forces the portable loop (to compare the two).
-    const char* forced = std::getenv("EVCORNER_EFAST_PATH");
-    if (forced != nullptr && std::strcmp(forced, "portable") == 0) return {detect_portable, "portable"};
+// The paths this CPU runs, fastest first.
+std::vector<Path> available() {
+    std::vector<Path> paths;
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
     __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2")) return {detect_avx2, "avx2"};
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
+        paths.push_back({"avx512", detect_avx512});
+    if (__builtin_cpu_supports("avx2")) paths.push_back({"avx2", detect_avx2});
 #endif
-    return {detect_portable, "portable"};
+    paths.push_back({"portable", detect_portable});
+    return paths;
 }
 
-const Choice& choice() noexcept {
-    static const Choice c = choose();
+const std::vector<Path>& paths() {
+    static const std::vector<Path> p = available();
+    return p;
+}
+
+const Path& choice() noexcept {
+    static const Path& c = [] () -> const Path& {
+        // EVCORNER_EFAST_PATH=portable (or avx2, avx512) forces a path this CPU runs.
+        if (const char* forced = std::getenv("EVCORNER_EFAST_PATH"))
+            for (const Path& p : paths())
+                if (std::strcmp(forced, p.name) == 0) return p;
+        return paths().front();
+    }();
     return c;
 }
 
@@ -54,5 +75,18 @@ std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uin
 }
 
 const char* efast_code_path() noexcept { return choice().name; }
+
+std::vector<std::string> efast_code_paths() {
+    std::vector<std::string> names;
+    for (const Path& p : paths()) names.emplace_back(p.name);
+    return names;
+}
+
+std::size_t detect_on_path(std::string_view path, EFast& det, std::span<const Event> events,
+                           std::span<std::uint8_t> is_corner) {
+    for (const Path& p : paths())
+        if (path == p.name) return p.loop(det, events, is_corner);
+    throw std::invalid_argument("eFAST code path '" + std::string(path) + "' does not run on this CPU");
+}
 
 }  // namespace evcorner

@@ -1,10 +1,13 @@
-// eFAST's code paths agree: the portable loop, the loop detect() picks for this CPU
-// (AVX2 where available), and the naive oracle, event for event; the AVX2 newest-pixel
-// search against the portable one on random circles.
+// eFAST's code paths agree: every loop this CPU runs (portable, AVX2, AVX-512), the one
+// detect() picks, and the naive oracle, event for event; the AVX2 and AVX-512 pieces
+// against the portable ones on random circles.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <stdexcept>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -40,19 +43,31 @@ std::vector<Event> blob_stream(SensorSize s, std::size_t n, std::uint32_t seed) 
 }
 
 void expect_paths_agree(const std::vector<Event>& events, SensorSize s) {
-    EFast portable(s), chosen(s);
     naive::EFastNaive oracle(s);
-    std::vector<std::uint8_t> a(events.size()), b(events.size());
-    portable.run<ScalarSearch>(events, a);
-    detect(chosen, std::span<const Event>(events), b);
+    std::vector<std::uint8_t> expected(events.size());
     std::size_t corners = 0;
-    for (std::size_t i = 0; i < events.size(); ++i) {
-        const bool o = oracle.process(events[i]);
-        ASSERT_EQ(a[i], o) << "portable, event " << i;
-        ASSERT_EQ(b[i], o) << efast_code_path() << ", event " << i;
-        corners += o;
-    }
+    for (std::size_t i = 0; i < events.size(); ++i) corners += expected[i] = oracle.process(events[i]);
     EXPECT_GT(corners, 0u);
+    const auto paths = efast_code_paths();
+    ASSERT_FALSE(paths.empty());
+    EXPECT_EQ(paths.back(), "portable");
+    for (const std::string& path : paths) {
+        EFast det(s);
+        std::vector<std::uint8_t> got(events.size(), 7);
+        EXPECT_EQ(detect_on_path(path, det, events, got), corners) << path;
+        for (std::size_t i = 0; i < events.size(); ++i) ASSERT_EQ(got[i], expected[i]) << path << ", event " << i;
+    }
+    EFast chosen(s);
+    std::vector<std::uint8_t> got(events.size(), 7);
+    detect(chosen, std::span<const Event>(events), got);
+    EXPECT_EQ(got, expected) << efast_code_path();
+}
+
+TEST(EFastPaths, UnknownPathIsRefused) {
+    EFast det(kDavis240);
+    std::vector<Event> none;
+    std::vector<std::uint8_t> flags;
+    EXPECT_THROW(detect_on_path("sse9", det, none, flags), std::invalid_argument);
 }
 
 TEST(EFastPaths, AgreeOnRandomStreams) {
@@ -85,6 +100,34 @@ TEST(EFastPaths, Avx2SearchFindsANewestPixel) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU";
     avx2_search_matches<16>(1);
     avx2_search_matches<20>(2);
+}
+
+[[gnu::target(EVCORNER_AVX512_TARGET)]] bool circle16_fires_avx512(const std::int64_t* t) {
+    alignas(64) static constexpr std::int64_t kOffsets[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+    return Avx512Search::circle16_fires(t, kOffsets);
+}
+
+TEST(EFastPaths, Avx512CircleTestMatchesTheDefinition) {
+    if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512vl") ||
+        !__builtin_cpu_supports("avx512bw") || !__builtin_cpu_supports("avx512dq"))
+        GTEST_SKIP() << "no AVX-512 (F, VL, BW, DQ) on this CPU";
+    std::mt19937_64 rng(7);
+    int fired = 0;
+    for (int round = 0; round < 400000; ++round) {
+        std::array<std::int64_t, 16> t{};
+        const std::int64_t range = round % 3 == 0 ? 3 : round % 3 == 1 ? 16 : 1000;  // ties: many .. few
+        for (auto& v : t) v = static_cast<std::int64_t>(rng() % range);
+        if (round % 4 == 0) {
+            // A planted arc of 2..7 newest pixels, so that firing circles are common.
+            const int start = static_cast<int>(rng() % 16), len = 2 + static_cast<int>(rng() % 6);
+            for (int k = 0; k < len; ++k) t[(start + k) % 16] = range + static_cast<std::int64_t>(rng() % 5);
+        }
+        if (round % 11 == 0) t[rng() % 16] = INT64_MIN;  // a pixel that never fired
+        const bool expected = arc_fires_naive<16, 3, 6>(t);
+        ASSERT_EQ(circle16_fires_avx512(t.data()), expected) << "round " << round;
+        fired += expected;
+    }
+    EXPECT_GT(fired, 10000);
 }
 #endif
 

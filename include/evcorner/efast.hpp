@@ -11,6 +11,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
 
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
@@ -63,9 +67,12 @@ private:
         std::int64_t* plane[2];
         std::ptrdiff_t width;
         int height;
+        alignas(64) std::int64_t off3[16];  // radius-3 circle offsets (the AVX-512 gather)
 
         static View make(Sae& sae) noexcept {
-            return {{sae.plane(0), sae.plane(1)}, sae.size().width, sae.size().height};
+            View v{{sae.plane(0), sae.plane(1)}, sae.size().width, sae.size().height, {}};
+            for (int k = 0; k < 16; ++k) v.off3[k] = kCircle3[k].dy * v.width + kCircle3[k].dx;
+            return v;
         }
 
         template <class Search>
@@ -78,6 +85,13 @@ private:
             // Offsets from compile-time circle coordinates: the loads address rows
             // centre + dy * width with constant column offsets.
             const std::ptrdiff_t w = width;
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+            if constexpr (std::is_same_v<Search, Avx512Search>) {
+                return Avx512Search::circle16_fires(centre, off3) &&
+                       circle_fires<kCircle4.size(), kArc4Min, kArc4Max, Search>(
+                           centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
+            }
+#endif
             return circle_fires<kCircle3.size(), kArc3Min, kArc3Max, Search>(
                        centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }) &&
                    circle_fires<kCircle4.size(), kArc4Min, kArc4Max, Search>(
@@ -89,12 +103,18 @@ private:
 };
 static_assert(Detector<EFast>);
 
-/// detect() for eFAST: the same flags, with the fastest code this CPU runs (AVX2 where
-/// the CPU has it, else portable), chosen once per process. Overload resolution picks
-/// it over the generic detect() of detector.hpp.
+/// detect() for eFAST: the same flags, with the fastest code this CPU runs (AVX-512,
+/// else AVX2, else portable), chosen once per process; the environment variable
+/// EVCORNER_EFAST_PATH=portable|avx2|avx512 forces one this CPU runs. Overload
+/// resolution picks it over the generic detect() of detector.hpp.
 std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
 
-/// The code path detect(EFast&, ...) takes on this CPU: "avx2" or "portable".
+/// The code path detect(EFast&, ...) takes: "avx512", "avx2" or "portable".
 const char* efast_code_path() noexcept;
+/// Every code path this CPU runs, fastest first.
+std::vector<std::string> efast_code_paths();
+/// detect() on a named path (one of efast_code_paths(); else std::invalid_argument).
+std::size_t detect_on_path(std::string_view path, EFast& det, std::span<const Event> events,
+                           std::span<std::uint8_t> is_corner);
 
 }  // namespace evcorner

@@ -12,7 +12,7 @@
 // sees the same distances: a halo is at least the detector's border margin), so the flags
 // are identical, in input order, for any number of threads.
 //
-// Parts outnumber threads (by default two per thread) and are handed out per batch,
+// Parts outnumber threads (by default four per thread) and are handed out per batch,
 // largest first, to whichever thread is free: the load balances however the events move
 // over the sensor, and the calling thread can do other work first (read the next batch:
 // see run()). Bands are cut from the first batch, fixed from then on, each at least 2r
@@ -98,7 +98,7 @@ public:
     /// `make(SensorSize)` builds one detector for a part's rows; `radius` is the
     /// detector's locality; `parts_per_thread` parts per thread are handed out per batch.
     template <class Make>
-    ParallelDetector(SensorSize size, int threads, int radius, Make make, int parts_per_thread = 2)
+    ParallelDetector(SensorSize size, int threads, int radius, Make make, int parts_per_thread = 4)
         : size_(size), radius_(radius), parts_per_thread_(std::max(1, parts_per_thread)),
           pool_(std::max(1, threads)), make_(std::move(make)) {
         if (pool_.size() == 1) single_ = std::make_unique<D>(make_(size_));
