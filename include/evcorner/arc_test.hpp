@@ -183,9 +183,9 @@ struct Avx2Search {
 };
 
 #define EVCORNER_AVX512_TARGET "avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt,lzcnt"
-/// AVX-512 (F, VL, BW, DQ): the whole cheap rejection of the radius-3 circle on all 16
-/// pixels at once (circle16_fires), with native 64-bit min/max, lane rotations and
-/// compares into mask registers.
+/// AVX-512 (F, VL, BW, DQ): the radius-3 circle's whole arc test on all 16 pixels at
+/// once (circle16_fires), with native 64-bit min/max, lane rotations and compares into
+/// mask registers.
 struct Avx512Search {
     // The radius-4 circle (tested for few events) keeps the AVX2 search.
     template <int N>
@@ -212,44 +212,44 @@ struct Avx512Search {
         return {_mm512_max_epi64(a.lo, b.lo), _mm512_max_epi64(a.hi, b.hi)};
     }
 
-    /// circle_fires<16, 3, 6> with the pixels at centre[offsets[k]]. The cheap rejection
-    /// of arc_fires_from() is computed for all 16 pixels at once as if each were the
-    /// newest (sliding minima and maxima by lane rotations), then read at the newest one;
-    /// the arc growth is arc_grows_from()'s. Only for code compiled for AVX-512.
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_fires(
-        const std::int64_t* centre, const std::int64_t* offsets) noexcept {
-        // Loaded one by one into the vectors: two vpgatherqq were slower (23.0 against
-        // 19.6 ns/event), and a copy through memory stalls on store forwarding.
+    /// circle_fires<16, 3, 6> with the pixels at centre[offsets[k]], by the definition
+    /// itself, for every arc at once and without a branch: the arc of length L starting at
+    /// pixel s fires iff min(t[s .. s+L-1]) > max(t[s+L .. s+15]). Sliding minima of
+    /// lengths 3..6 and sliding maxima of lengths 10..13 are built from lane rotations
+    /// (each window from two shorter ones); 4 compares of 16 lanes decide. About 65
+    /// vector instructions, against a data-dependent branch and the arc growth of
+    /// arc_fires_from(). Only for code compiled for AVX-512.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_fires(const std::int64_t* centre,
+                                                                           const std::int64_t* offsets) noexcept {
+        // Loaded one by one into the vectors: two vpgatherqq were slower, and a copy
+        // through memory stalls on store forwarding.
         const std::int64_t* o = offsets;
         const V16 t{_mm512_set_epi64(centre[o[7]], centre[o[6]], centre[o[5]], centre[o[4]], centre[o[3]],
                                      centre[o[2]], centre[o[1]], centre[o[0]]),
                     _mm512_set_epi64(centre[o[15]], centre[o[14]], centre[o[13]], centre[o[12]], centre[o[11]],
                                      centre[o[10]], centre[o[9]], centre[o[8]])};
-        const V16 r1 = rot<1>(t);
-        const V16 w3 = vmin(vmin(t, r1), rot<2>(t));                // min of t[k..k+2]
-        const V16 bound = vmax(w3, vmax(rot<15>(w3), rot<14>(w3)));  // best 3-window through k
+        const V16 r1 = rot<1>(t), r2 = rot<2>(t), r4 = rot<4>(t);
+        // wL[s] = min(t[s .. s+L-1]): the oldest of the arc of length L from s.
+        const V16 w2 = vmin(t, r1);
+        const V16 w3 = vmin(w2, r2);
+        const V16 w4 = vmin(w2, rot<2>(w2));
+        const V16 w5 = vmin(w4, r4);
+        const V16 w6 = vmin(w4, rot<4>(w2));
+        // xM[s] = max(t[s .. s+M-1]); the rest of the arc (L, s) is x(16-L)[s+L].
         const V16 x2 = vmax(t, r1);
-        const V16 x5 = vmax(vmax(x2, rot<2>(x2)), rot<4>(t));  // max of t[k..k+4]
-        const V16 opposite = rot<6>(x5);                        // max of t[k+6..k+10]
-        const unsigned pass = static_cast<unsigned>(_mm512_cmpgt_epi64_mask(bound.lo, opposite.lo)) |
-                              static_cast<unsigned>(_mm512_cmpgt_epi64_mask(bound.hi, opposite.hi)) << 8;
-        __m512i m = _mm512_max_epi64(t.lo, t.hi);
-        m = _mm512_max_epi64(m, _mm512_shuffle_i64x2(m, m, 0x4E));
-        m = _mm512_max_epi64(m, _mm512_shuffle_i64x2(m, m, 0xB1));
-        m = _mm512_max_epi64(m, _mm512_shuffle_epi32(m, _MM_PERM_BADC));
-        const unsigned newest = static_cast<unsigned>(_mm512_cmpeq_epi64_mask(t.lo, m)) |
-                                static_cast<unsigned>(_mm512_cmpeq_epi64_mask(t.hi, m)) << 8;
-        const int c = __builtin_ctz(newest);
-        if (((pass >> c) & 1u) == 0) return false;
-        alignas(64) std::int64_t a[32];
-        _mm512_store_si512(a, t.lo);
-        _mm512_store_si512(a + 8, t.hi);
-        _mm512_store_si512(a + 16, t.lo);
-        _mm512_store_si512(a + 24, t.hi);
-        alignas(64) std::int64_t opp[16];
-        _mm512_store_si512(opp, opposite.lo);
-        _mm512_store_si512(opp + 8, opposite.hi);
-        return arc_grows_from<16, 3, 6>(a, c + 16 * static_cast<int>(c < 6), opp[c]);
+        const V16 x3 = vmax(x2, r2);
+        const V16 x4 = vmax(x2, rot<2>(x2));
+        const V16 x5 = vmax(x4, r4);
+        const V16 x8 = vmax(x4, rot<4>(x4));
+        const V16 rest3 = rot<3>(vmax(x8, rot<8>(x5)));  // max(t[s+3 .. s+15])
+        const V16 rest4 = rot<4>(vmax(x8, rot<8>(x4)));  // max(t[s+4 .. s+15])
+        const V16 rest5 = rot<5>(vmax(x8, rot<8>(x3)));  // max(t[s+5 .. s+15])
+        const V16 rest6 = rot<6>(vmax(x8, rot<8>(x2)));  // max(t[s+6 .. s+15])
+        const __mmask8 lo = _mm512_cmpgt_epi64_mask(w3.lo, rest3.lo) | _mm512_cmpgt_epi64_mask(w4.lo, rest4.lo) |
+                            _mm512_cmpgt_epi64_mask(w5.lo, rest5.lo) | _mm512_cmpgt_epi64_mask(w6.lo, rest6.lo);
+        const __mmask8 hi = _mm512_cmpgt_epi64_mask(w3.hi, rest3.hi) | _mm512_cmpgt_epi64_mask(w4.hi, rest4.hi) |
+                            _mm512_cmpgt_epi64_mask(w5.hi, rest5.hi) | _mm512_cmpgt_epi64_mask(w6.hi, rest6.hi);
+        return (lo | hi) != 0;
     }
 };
 #endif
