@@ -30,7 +30,9 @@ std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span
 // never read (the mask is all ones).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t detect_avx512(
     EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
     return det.run<Avx512Search>(events, is_corner);

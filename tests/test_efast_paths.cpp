@@ -105,7 +105,9 @@ TEST(EFastPaths, Avx2SearchFindsANewestPixel) {
 // GCC 12 warns falsely about the intrinsics' pass-through operand once inlined (see efast.cpp).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 [[gnu::target(EVCORNER_AVX512_TARGET)]] bool circle16_fires_avx512(const std::int64_t* t) {
     alignas(64) static constexpr std::int64_t kOffsets[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
     return Avx512Search::circle16_fires(t, kOffsets);
