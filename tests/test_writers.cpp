@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstring>
@@ -173,6 +174,59 @@ TEST(Npy, PackedDtypeAndDamage) {
     {
         std::string f("\x93NUMPY\x01\x00\xff\xff", 10);  // a 65535-byte header that is not there
         EXPECT_THROW(io::NpyReader(tmp.write("l.npy", f)), InputError);
+    }
+}
+
+// The reader checks records in runs (BinaryReader::push_run) and hands the first one that
+// fails a check to the slow path: every record is still checked, skipped or reported at
+// its own byte offset, across batch boundaries.
+TEST(Npy, EveryRecordIsCheckedAcrossRunsAndBatches) {
+    TempDir tmp;
+    std::vector<Event> events;
+    for (int i = 0; i < 20000; ++i)
+        events.push_back({i / 3, static_cast<std::uint16_t>(i % 240), static_cast<std::uint16_t>(i % 180),
+                          static_cast<std::uint8_t>(i & 1)});
+    // Outside a 240x180 sensor: single events and a run of three, at batch edges too.
+    std::vector<std::size_t> outside = {0, 17, 4095, 4096, 9000, 9001, 9002, 19999};
+    for (const std::size_t i : outside) events[i].x = 300;
+    const std::string path = tmp.path("e.npy");
+    {
+        auto w = io::open_event_writer(path, "npy");
+        w->write(events);
+        w->close();
+    }
+    std::vector<Event> kept;
+    for (std::size_t i = 0; i < events.size(); ++i)
+        if (std::find(outside.begin(), outside.end(), i) == outside.end()) kept.push_back(events[i]);
+    {
+        io::ReaderOptions o;
+        o.skip_invalid = true;  // 240x180 fallback sensor
+        io::NpyReader r(path, o);
+        const ReadResult res = read_all(r, 4096);
+        EXPECT_FALSE(res.failed) << res.error;
+        EXPECT_EQ(res.skipped, outside.size());
+        EXPECT_EQ(res.events, kept);
+    }
+    {
+        io::NpyReader r(path);  // no skipping: the first outside event is an error at its offset
+        const ReadResult res = read_all(r, 4096);
+        ASSERT_TRUE(res.failed);
+        EXPECT_TRUE(res.events.empty());
+        EXPECT_EQ(res.error_position, 192u);  // record 0, right after the 192-byte header
+    }
+    {
+        // Time going backwards at record 12345: the events before it come first.
+        std::vector<Event> back = kept;
+        back[12345].t = back[12344].t - 1;
+        auto w = io::open_event_writer(tmp.path("b.npy"), "npy");
+        w->write(back);
+        w->close();
+        io::NpyReader r(tmp.path("b.npy"));
+        const ReadResult res = read_all(r, 4096);
+        ASSERT_TRUE(res.failed);
+        EXPECT_EQ(res.events, std::vector<Event>(back.begin(), back.begin() + 12345));
+        EXPECT_EQ(res.error_position, 192u + 16u * 12345u);
+        EXPECT_NE(res.error.find("backwards"), std::string::npos) << res.error;
     }
 }
 
