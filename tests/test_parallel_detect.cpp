@@ -123,6 +123,20 @@ TEST(ParallelDetect, HarrisRandomHdStream) {
     expect_same_as_one_thread<Harris>(events, hd, HarrisParams{}.window / 2, [](SensorSize z) { return Harris(z); }, 9000);
 }
 
+TEST(ParallelDetect, BatchesThatLeavePartsEmpty) {
+    // The first batch spreads over the whole sensor (all parts get events), later ones
+    // stay in a few rows of one polarity, so most parts see nothing in them.
+    const SensorSize s{240, 180};
+    std::vector<Event> events = random_stream(s, 20000, 21);
+    std::mt19937_64 rng(5);
+    std::int64_t t = events.back().t;
+    for (int i = 0; i < 60000; ++i) {
+        t += static_cast<std::int64_t>(rng() % 2);
+        events.push_back({t, static_cast<std::uint16_t>(20 + rng() % 40), static_cast<std::uint16_t>(30 + rng() % 12), 1});
+    }
+    expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [](SensorSize z) { return EFast(z); }, 20000);
+}
+
 TEST(ParallelDetect, BandsSplitEachPolarityEvenly) {
     const SensorSize hd{1280, 720};
     const auto events = random_stream(hd, 50000, 9);

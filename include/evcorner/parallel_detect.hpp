@@ -160,9 +160,11 @@ public:
         });
         // Corners are sparse: set them here rather than have threads write bytes that
         // share cache lines. Each event belongs to one part, so the order is the input's.
+        // Only the parts that had events in this batch ran: the others hold old answers.
         std::fill(is_corner.begin(), is_corner.end(), std::uint8_t{0});
         std::size_t corners = 0;
-        for (const Part& part : parts_) {
+        for (const std::uint32_t j : s.order) {
+            const Part& part = parts_[j];
             for (std::size_t k = 0; k < part.found; ++k) is_corner[part.corners.data[k]] = 1;
             corners += part.found;
         }
