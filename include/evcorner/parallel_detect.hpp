@@ -107,10 +107,12 @@ public:
     [[nodiscard]] int threads() const noexcept { return pool_.size(); }
     [[nodiscard]] std::span<const DetectPart> parts() const noexcept { return plan_; }
 
-    /// Like detect(det, events, is_corner) for a single detector, continuing the stream.
-    /// With several threads, reading batch k + 1 of the span overlaps detecting batch k.
+    /// Like detect(det, events, is_corner) for a single detector, continuing the stream:
+    /// prepare() and run() over the span in batches, preparing batch k + 1 while batch k
+    /// is detected. Not while batches of prepare() wait for their run().
     std::size_t detect(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
         if (single_) return detail::run_batch(*single_, events, is_corner);
+        if (queued_ != 0) throw std::logic_error("ParallelDetector::detect: batches prepared and not run");
         std::size_t corners = 0;
         if (events.empty()) return 0;
         prepare(events.first(std::min(kMaxBatch, events.size())));
