@@ -112,29 +112,40 @@ TEST(EFastPaths, Avx2SearchFindsANewestPixel) {
     alignas(64) static constexpr std::int64_t kOffsets[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
     return Avx512Search::circle16_fires(t, kOffsets);
 }
+[[gnu::target(EVCORNER_AVX512_TARGET)]] bool circle20_fires_avx512(const std::int64_t* t) {
+    static constexpr std::int64_t kOffsets[20] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19};
+    return Avx512Search::circle20_fires(t, kOffsets);
+}
 #pragma GCC diagnostic pop
 
-TEST(EFastPaths, Avx512CircleTestMatchesTheDefinition) {
-    if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512vl") ||
-        !__builtin_cpu_supports("avx512bw") || !__builtin_cpu_supports("avx512dq"))
-        GTEST_SKIP() << "no AVX-512 (F, VL, BW, DQ) on this CPU";
-    std::mt19937_64 rng(7);
+// Random circles of N pixels: many and few ties, planted arcs of 2..Lmax+1 newest pixels,
+// never-fired pixels; the vector test must equal the definition on every one.
+template <int N, int Lmin, int Lmax, class Test>
+void vector_circle_test_matches(Test test, std::uint64_t seed) {
+    std::mt19937_64 rng(seed);
     int fired = 0;
     for (int round = 0; round < 400000; ++round) {
-        std::array<std::int64_t, 16> t{};
-        const std::int64_t range = round % 3 == 0 ? 3 : round % 3 == 1 ? 16 : 1000;  // ties: many .. few
+        std::array<std::int64_t, N> t{};
+        const std::int64_t range = round % 3 == 0 ? 3 : round % 3 == 1 ? N : 1000;
         for (auto& v : t) v = static_cast<std::int64_t>(rng() % range);
         if (round % 4 == 0) {
-            // A planted arc of 2..7 newest pixels, so that firing circles are common.
-            const int start = static_cast<int>(rng() % 16), len = 2 + static_cast<int>(rng() % 6);
-            for (int k = 0; k < len; ++k) t[(start + k) % 16] = range + static_cast<std::int64_t>(rng() % 5);
+            const int start = static_cast<int>(rng() % N), len = 2 + static_cast<int>(rng() % Lmax);
+            for (int k = 0; k < len; ++k) t[(start + k) % N] = range + static_cast<std::int64_t>(rng() % 5);
         }
-        if (round % 11 == 0) t[rng() % 16] = INT64_MIN;  // a pixel that never fired
-        const bool expected = arc_fires_naive<16, 3, 6>(t);
-        ASSERT_EQ(circle16_fires_avx512(t.data()), expected) << "round " << round;
+        if (round % 11 == 0) t[rng() % N] = INT64_MIN;  // a pixel that never fired
+        const bool expected = arc_fires_naive<N, Lmin, Lmax>(t);
+        ASSERT_EQ(test(t.data()), expected) << "round " << round;
         fired += expected;
     }
     EXPECT_GT(fired, 10000);
+}
+
+TEST(EFastPaths, Avx512CircleTestsMatchTheDefinition) {
+    if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512vl") ||
+        !__builtin_cpu_supports("avx512bw") || !__builtin_cpu_supports("avx512dq"))
+        GTEST_SKIP() << "no AVX-512 (F, VL, BW, DQ) on this CPU";
+    vector_circle_test_matches<16, 3, 6>(circle16_fires_avx512, 7);
+    vector_circle_test_matches<20, 4, 8>(circle20_fires_avx512, 8);
 }
 #endif
 

@@ -183,16 +183,10 @@ struct Avx2Search {
 };
 
 #define EVCORNER_AVX512_TARGET "avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt,lzcnt"
-/// AVX-512 (F, VL, BW, DQ): the radius-3 circle's whole arc test on all 16 pixels at
-/// once (circle16_fires), with native 64-bit min/max, lane rotations and compares into
-/// mask registers.
+/// AVX-512 (F, VL, BW, DQ): each circle's whole arc test for all its arcs at once
+/// (circle16_fires, circle20_fires), with native 64-bit min/max, lane rotations and
+/// compares into mask registers.
 struct Avx512Search {
-    // The radius-4 circle (tested for few events) keeps the AVX2 search.
-    template <int N>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static int newest(std::int64_t* t) noexcept {
-        return Avx2Search::newest<N>(t);
-    }
-
     // A 16-pixel circle as two vectors: lo = t[0..8), hi = t[8..16).
     struct V16 {
         __m512i lo, hi;
@@ -250,6 +244,76 @@ struct Avx512Search {
         const __mmask8 hi = _mm512_cmpgt_epi64_mask(w3.hi, rest3.hi) | _mm512_cmpgt_epi64_mask(w4.hi, rest4.hi) |
                             _mm512_cmpgt_epi64_mask(w5.hi, rest5.hi) | _mm512_cmpgt_epi64_mask(w6.hi, rest6.hi);
         return (lo | hi) != 0;
+    }
+
+    // A 20-pixel circle, periodically extended to 32 lanes: lane m holds t[m mod 20], in
+    // four vectors (t[0..8), t[8..16), t[16..20) t[0..4), t[4..12)). Any 8 cyclically
+    // consecutive pixels t[a..a+8) (a < 20) are then lanes a..a+8 < 32: one valignq.
+    struct V20 {
+        __m512i v[4];
+    };
+    template <int A>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m512i window20(const V20& x) noexcept {
+        static_assert(A >= 0 && A < 20);
+        if constexpr (A % 8 == 0) return x.v[A / 8];
+        else return _mm512_alignr_epi64(x.v[A / 8 + 1], x.v[A / 8], A % 8);
+    }
+    // t[k + J] (mod 20) in lane k.
+    template <int J>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V20 rot20(const V20& x) noexcept {
+        return {{window20<J % 20>(x), window20<(8 + J) % 20>(x), window20<(16 + J) % 20>(x),
+                 window20<(24 + J) % 20>(x)}};
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V20 vmin(const V20& a, const V20& b) noexcept {
+        return {{_mm512_min_epi64(a.v[0], b.v[0]), _mm512_min_epi64(a.v[1], b.v[1]),
+                 _mm512_min_epi64(a.v[2], b.v[2]), _mm512_min_epi64(a.v[3], b.v[3])}};
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V20 vmax(const V20& a, const V20& b) noexcept {
+        return {{_mm512_max_epi64(a.v[0], b.v[0]), _mm512_max_epi64(a.v[1], b.v[1]),
+                 _mm512_max_epi64(a.v[2], b.v[2]), _mm512_max_epi64(a.v[3], b.v[3])}};
+    }
+    // Any lane of the first 20 (lanes 20..23 repeat lanes 0..3) where a > b.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline unsigned any_greater(const V20& a, const V20& b) noexcept {
+        return static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[0], b.v[0]) |
+                                     _mm512_cmpgt_epi64_mask(a.v[1], b.v[1]) |
+                                     _mm512_cmpgt_epi64_mask(a.v[2], b.v[2]));
+    }
+
+    /// circle_fires<20, 4, 8> with the pixels at centre[offsets[k]], as circle16_fires():
+    /// the arc of length L from s fires iff min(t[s .. s+L-1]) > max(t[s+L .. s+19]),
+    /// for all 20 starts and the lengths 4..8 at once, without a branch.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle20_fires(const std::int64_t* centre,
+                                                                           const std::int64_t* offsets) noexcept {
+        const std::int64_t* o = offsets;
+        std::int64_t p[20];
+        for (int k = 0; k < 20; ++k) p[k] = centre[o[k]];
+        const V20 t{{_mm512_set_epi64(p[7], p[6], p[5], p[4], p[3], p[2], p[1], p[0]),
+                     _mm512_set_epi64(p[15], p[14], p[13], p[12], p[11], p[10], p[9], p[8]),
+                     _mm512_set_epi64(p[3], p[2], p[1], p[0], p[19], p[18], p[17], p[16]),
+                     _mm512_set_epi64(p[11], p[10], p[9], p[8], p[7], p[6], p[5], p[4])}};
+        const V20 r1 = rot20<1>(t), r2 = rot20<2>(t), r4 = rot20<4>(t);
+        // wL[s] = min(t[s .. s+L-1]).
+        const V20 w2 = vmin(t, r1);
+        const V20 w3 = vmin(w2, r2);
+        const V20 w4 = vmin(w2, rot20<2>(w2));
+        const V20 w5 = vmin(w4, r4);
+        const V20 w6 = vmin(w4, rot20<4>(w2));
+        const V20 w7 = vmin(w4, rot20<4>(w3));
+        const V20 w8 = vmin(w4, rot20<4>(w4));
+        // xM[s] = max(t[s .. s+M-1]); the rest of the arc (L, s) is x(20-L)[s+L].
+        const V20 x2 = vmax(t, r1);
+        const V20 x3 = vmax(x2, r2);
+        const V20 x4 = vmax(x2, rot20<2>(x2));
+        const V20 x5 = vmax(x4, r4);
+        const V20 x6 = vmax(x4, rot20<4>(x2));
+        const V20 x7 = vmax(x4, rot20<4>(x3));
+        const V20 x8 = vmax(x4, rot20<4>(x4));
+        const unsigned fires = any_greater(w4, rot20<4>(vmax(x8, rot20<8>(x8)))) |   // rest of 16
+                               any_greater(w5, rot20<5>(vmax(x8, rot20<8>(x7)))) |   // rest of 15
+                               any_greater(w6, rot20<6>(vmax(x8, rot20<8>(x6)))) |   // rest of 14
+                               any_greater(w7, rot20<7>(vmax(x8, rot20<8>(x5)))) |   // rest of 13
+                               any_greater(w8, rot20<8>(vmax(x8, rot20<8>(x4))));    // rest of 12
+        return fires != 0;
     }
 };
 #endif

@@ -67,11 +67,14 @@ private:
         std::int64_t* plane[2];
         std::ptrdiff_t width;
         int height;
-        alignas(64) std::int64_t off3[16];  // radius-3 circle offsets (the AVX-512 gather)
+        // Circle offsets (the AVX-512 path loads the circles through them).
+        std::int64_t off3[16];
+        std::int64_t off4[20];
 
         static View make(Sae& sae) noexcept {
-            View v{{sae.plane(0), sae.plane(1)}, sae.size().width, sae.size().height, {}};
+            View v{{sae.plane(0), sae.plane(1)}, sae.size().width, sae.size().height, {}, {}};
             for (int k = 0; k < 16; ++k) v.off3[k] = kCircle3[k].dy * v.width + kCircle3[k].dx;
+            for (int k = 0; k < 20; ++k) v.off4[k] = kCircle4[k].dy * v.width + kCircle4[k].dx;
             return v;
         }
 
@@ -87,15 +90,15 @@ private:
             const std::ptrdiff_t w = width;
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
             if constexpr (std::is_same_v<Search, Avx512Search>) {
-                return Avx512Search::circle16_fires(centre, off3) &&
+                return Avx512Search::circle16_fires(centre, off3) && Avx512Search::circle20_fires(centre, off4);
+            } else
+#endif
+            {
+                return circle_fires<kCircle3.size(), kArc3Min, kArc3Max, Search>(
+                           centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }) &&
                        circle_fires<kCircle4.size(), kArc4Min, kArc4Max, Search>(
                            centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
             }
-#endif
-            return circle_fires<kCircle3.size(), kArc3Min, kArc3Max, Search>(
-                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }) &&
-                   circle_fires<kCircle4.size(), kArc4Min, kArc4Max, Search>(
-                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
         }
     };
 
