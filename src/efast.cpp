@@ -25,19 +25,10 @@ std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span
                                                                std::span<std::uint8_t> is_corner) noexcept {
     return det.run<Avx2Search>(events, is_corner);
 }
-// GCC 12 warns that the AVX-512 intrinsics' own pass-through operand
-// (_mm512_undefined_epi32) is used uninitialised once they are inlined here: it is
-// never read (the mask is all ones).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t detect_avx512(
     EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
     return det.run<Avx512Search>(events, is_corner);
 }
-#pragma GCC diagnostic pop
 #endif
 
 using Loop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>) noexcept;

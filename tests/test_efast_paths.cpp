@@ -102,12 +102,6 @@ TEST(EFastPaths, Avx2SearchFindsANewestPixel) {
     avx2_search_matches<20>(2);
 }
 
-// GCC 12 warns falsely about the intrinsics' pass-through operand once inlined (see efast.cpp).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
 [[gnu::target(EVCORNER_AVX512_TARGET)]] bool circle16_fires_avx512(const std::int64_t* t) {
     alignas(64) static constexpr std::int64_t kOffsets[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
     return Avx512Search::circle16_fires(t, kOffsets);
@@ -116,7 +110,6 @@ TEST(EFastPaths, Avx2SearchFindsANewestPixel) {
     static constexpr std::int64_t kOffsets[20] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19};
     return Avx512Search::circle20_fires(t, kOffsets);
 }
-#pragma GCC diagnostic pop
 
 // Random circles of N pixels: many and few ties, planted arcs of 2..Lmax+1 newest pixels,
 // never-fired pixels; the vector test must equal the definition on every one.

@@ -17,6 +17,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <utility>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -184,138 +185,118 @@ struct Avx2Search {
 
 #define EVCORNER_AVX512_TARGET "avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt,lzcnt"
 /// AVX-512 (F, VL, BW, DQ): each circle's whole arc test for all its arcs at once
-/// (circle16_fires, circle20_fires), with native 64-bit min/max, lane rotations and
-/// compares into mask registers.
+/// (circle16_fires, circle20_fires), by the definition: the arc of length L from pixel s
+/// fires iff min(t[s .. s+L-1]) > max(t[s+L .. s+N-1]). With the circle in vector
+/// registers and rot<J>() putting t[k+J] in lane k, the oldest of every arc of each
+/// length and the newest of every rest are sliding minima and maxima, each built from two
+/// shorter windows (sliding()); one compare per length decides. No data-dependent branch
+/// and no arc growth. Only for code compiled for AVX-512.
+// GCC 12 warns that the intrinsics' own pass-through operand (_mm512_undefined_epi32) is
+// used uninitialised once they are inlined: it is never read (the mask is all ones).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 struct Avx512Search {
-    // A 16-pixel circle as two vectors: lo = t[0..8), hi = t[8..16).
-    struct V16 {
-        __m512i lo, hi;
+    // A 16-pixel circle in two vectors: t[0..8), t[8..16).
+    struct Circle16 {
+        __m512i v[2];
+        // t[k + J] (mod 16) in lane k.
+        template <int J>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Circle16 rot() const noexcept {
+            constexpr int j = J % 16;
+            if constexpr (j == 0) return *this;
+            else if constexpr (j < 8) return {{_mm512_alignr_epi64(v[1], v[0], j), _mm512_alignr_epi64(v[0], v[1], j)}};
+            else if constexpr (j == 8) return {{v[1], v[0]}};
+            else return {{_mm512_alignr_epi64(v[0], v[1], j - 8), _mm512_alignr_epi64(v[1], v[0], j - 8)}};
+        }
+        // Any of the 16 lanes where a > b.
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] friend unsigned any_greater(const Circle16& a, const Circle16& b) noexcept {
+            return static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[0], b.v[0]) | _mm512_cmpgt_epi64_mask(a.v[1], b.v[1]));
+        }
     };
-    // t[k + J] for every k (cyclic).
-    template <int J>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V16 rot(V16 v) noexcept {
-        if constexpr (J == 0) return v;
-        else if constexpr (J < 8) return {_mm512_alignr_epi64(v.hi, v.lo, J), _mm512_alignr_epi64(v.lo, v.hi, J)};
-        else if constexpr (J == 8) return {v.hi, v.lo};
-        else return {_mm512_alignr_epi64(v.lo, v.hi, J - 8), _mm512_alignr_epi64(v.hi, v.lo, J - 8)};
+    // A 20-pixel circle extended periodically to 32 lanes, lane m holding t[m mod 20], in
+    // four vectors (t[0..8), t[8..16), t[16..20) t[0..4), t[4..12)): any 8 cyclically
+    // consecutive pixels t[a..a+8) (a < 20) are lanes a..a+8 < 32, one valignq away.
+    struct Circle20 {
+        __m512i v[4];
+        template <int A>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] __m512i window() const noexcept {
+            if constexpr (A % 8 == 0) return v[A / 8];
+            else return _mm512_alignr_epi64(v[A / 8 + 1], v[A / 8], A % 8);
+        }
+        // t[k + J] (mod 20) in lane k.
+        template <int J>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Circle20 rot() const noexcept {
+            return {{window<J % 20>(), window<(8 + J) % 20>(), window<(16 + J) % 20>(), window<(24 + J) % 20>()}};
+        }
+        // Any of the first 20 lanes where a > b (lanes 20..23 repeat lanes 0..3).
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] friend unsigned any_greater(const Circle20& a, const Circle20& b) noexcept {
+            return static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[0], b.v[0]) | _mm512_cmpgt_epi64_mask(a.v[1], b.v[1]) |
+                                         _mm512_cmpgt_epi64_mask(a.v[2], b.v[2]));
+        }
+    };
+
+    // Lane by lane, min (Max = false) or max of two circles.
+    template <bool Max, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline C lanes(const C& a, const C& b) noexcept {
+        C r;
+        for (std::size_t i = 0; i < std::size(a.v); ++i)
+            r.v[i] = Max ? _mm512_max_epi64(a.v[i], b.v[i]) : _mm512_min_epi64(a.v[i], b.v[i]);
+        return r;
     }
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V16 vmin(V16 a, V16 b) noexcept {
-        return {_mm512_min_epi64(a.lo, b.lo), _mm512_min_epi64(a.hi, b.hi)};
+    // The min (or max) of t[s .. s+L-1] in lane s: the window of the largest power of two
+    // h < L at s, and the window of the other L - h pixels at s + h. Rotations by powers
+    // of two recur, and rot<8> of a 16-pixel circle is free (its two vectors swapped);
+    // shared sub-windows are computed once by the compiler (the intrinsics are pure).
+    template <int L, bool Max, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline C sliding(const C& t) noexcept {
+        if constexpr (L == 1) {
+            return t;
+        } else {
+            constexpr int h = (L & (L - 1)) == 0 ? L / 2 : 1 << (31 - __builtin_clz(static_cast<unsigned>(L)));
+            return lanes<Max>(sliding<h, Max>(t), sliding<L - h, Max>(t).template rot<h>());
+        }
     }
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V16 vmax(V16 a, V16 b) noexcept {
-        return {_mm512_max_epi64(a.lo, b.lo), _mm512_max_epi64(a.hi, b.hi)};
+    // Whether some arc of a length in Lmin..Lmax fires.
+    template <int N, int Lmin, int Lmax, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool fires(const C& t) noexcept {
+        unsigned any = 0;
+        [&]<int... I>(std::integer_sequence<int, I...>) {
+            ((any |= any_greater(sliding<Lmin + I, false>(t),
+                                 sliding<N - Lmin - I, true>(t).template rot<Lmin + I>())),
+             ...);
+        }(std::make_integer_sequence<int, Lmax - Lmin + 1>{});
+        return any != 0;
     }
 
-    /// circle_fires<16, 3, 6> with the pixels at centre[offsets[k]], by the definition
-    /// itself, for every arc at once and without a branch: the arc of length L starting at
-    /// pixel s fires iff min(t[s .. s+L-1]) > max(t[s+L .. s+15]). Sliding minima of
-    /// lengths 3..6 and sliding maxima of lengths 10..13 are built from lane rotations
-    /// (each window from two shorter ones); 4 compares of 16 lanes decide. About 65
-    /// vector instructions, against a data-dependent branch and the arc growth of
-    /// arc_fires_from(). Only for code compiled for AVX-512.
+    /// circle_fires<16, 3, 6> with the pixels at centre[offsets[k]].
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_fires(const std::int64_t* centre,
                                                                            const std::int64_t* offsets) noexcept {
         // Loaded one by one into the vectors: two vpgatherqq were slower, and a copy
         // through memory stalls on store forwarding.
         const std::int64_t* o = offsets;
-        const V16 t{_mm512_set_epi64(centre[o[7]], centre[o[6]], centre[o[5]], centre[o[4]], centre[o[3]],
-                                     centre[o[2]], centre[o[1]], centre[o[0]]),
-                    _mm512_set_epi64(centre[o[15]], centre[o[14]], centre[o[13]], centre[o[12]], centre[o[11]],
-                                     centre[o[10]], centre[o[9]], centre[o[8]])};
-        const V16 r1 = rot<1>(t), r2 = rot<2>(t), r4 = rot<4>(t);
-        // wL[s] = min(t[s .. s+L-1]): the oldest of the arc of length L from s.
-        const V16 w2 = vmin(t, r1);
-        const V16 w3 = vmin(w2, r2);
-        const V16 w4 = vmin(w2, rot<2>(w2));
-        const V16 w5 = vmin(w4, r4);
-        const V16 w6 = vmin(w4, rot<4>(w2));
-        // xM[s] = max(t[s .. s+M-1]); the rest of the arc (L, s) is x(16-L)[s+L].
-        const V16 x2 = vmax(t, r1);
-        const V16 x3 = vmax(x2, r2);
-        const V16 x4 = vmax(x2, rot<2>(x2));
-        const V16 x5 = vmax(x4, r4);
-        const V16 x8 = vmax(x4, rot<4>(x4));
-        const V16 rest3 = rot<3>(vmax(x8, rot<8>(x5)));  // max(t[s+3 .. s+15])
-        const V16 rest4 = rot<4>(vmax(x8, rot<8>(x4)));  // max(t[s+4 .. s+15])
-        const V16 rest5 = rot<5>(vmax(x8, rot<8>(x3)));  // max(t[s+5 .. s+15])
-        const V16 rest6 = rot<6>(vmax(x8, rot<8>(x2)));  // max(t[s+6 .. s+15])
-        const __mmask8 lo = _mm512_cmpgt_epi64_mask(w3.lo, rest3.lo) | _mm512_cmpgt_epi64_mask(w4.lo, rest4.lo) |
-                            _mm512_cmpgt_epi64_mask(w5.lo, rest5.lo) | _mm512_cmpgt_epi64_mask(w6.lo, rest6.lo);
-        const __mmask8 hi = _mm512_cmpgt_epi64_mask(w3.hi, rest3.hi) | _mm512_cmpgt_epi64_mask(w4.hi, rest4.hi) |
-                            _mm512_cmpgt_epi64_mask(w5.hi, rest5.hi) | _mm512_cmpgt_epi64_mask(w6.hi, rest6.hi);
-        return (lo | hi) != 0;
+        const Circle16 t{{_mm512_set_epi64(centre[o[7]], centre[o[6]], centre[o[5]], centre[o[4]], centre[o[3]],
+                                           centre[o[2]], centre[o[1]], centre[o[0]]),
+                          _mm512_set_epi64(centre[o[15]], centre[o[14]], centre[o[13]], centre[o[12]],
+                                           centre[o[11]], centre[o[10]], centre[o[9]], centre[o[8]])}};
+        return fires<16, 3, 6>(t);
     }
 
-    // A 20-pixel circle, periodically extended to 32 lanes: lane m holds t[m mod 20], in
-    // four vectors (t[0..8), t[8..16), t[16..20) t[0..4), t[4..12)). Any 8 cyclically
-    // consecutive pixels t[a..a+8) (a < 20) are then lanes a..a+8 < 32: one valignq.
-    struct V20 {
-        __m512i v[4];
-    };
-    template <int A>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m512i window20(const V20& x) noexcept {
-        static_assert(A >= 0 && A < 20);
-        if constexpr (A % 8 == 0) return x.v[A / 8];
-        else return _mm512_alignr_epi64(x.v[A / 8 + 1], x.v[A / 8], A % 8);
-    }
-    // t[k + J] (mod 20) in lane k.
-    template <int J>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V20 rot20(const V20& x) noexcept {
-        return {{window20<J % 20>(x), window20<(8 + J) % 20>(x), window20<(16 + J) % 20>(x),
-                 window20<(24 + J) % 20>(x)}};
-    }
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V20 vmin(const V20& a, const V20& b) noexcept {
-        return {{_mm512_min_epi64(a.v[0], b.v[0]), _mm512_min_epi64(a.v[1], b.v[1]),
-                 _mm512_min_epi64(a.v[2], b.v[2]), _mm512_min_epi64(a.v[3], b.v[3])}};
-    }
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline V20 vmax(const V20& a, const V20& b) noexcept {
-        return {{_mm512_max_epi64(a.v[0], b.v[0]), _mm512_max_epi64(a.v[1], b.v[1]),
-                 _mm512_max_epi64(a.v[2], b.v[2]), _mm512_max_epi64(a.v[3], b.v[3])}};
-    }
-    // Any lane of the first 20 (lanes 20..23 repeat lanes 0..3) where a > b.
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline unsigned any_greater(const V20& a, const V20& b) noexcept {
-        return static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[0], b.v[0]) |
-                                     _mm512_cmpgt_epi64_mask(a.v[1], b.v[1]) |
-                                     _mm512_cmpgt_epi64_mask(a.v[2], b.v[2]));
-    }
-
-    /// circle_fires<20, 4, 8> with the pixels at centre[offsets[k]], as circle16_fires():
-    /// the arc of length L from s fires iff min(t[s .. s+L-1]) > max(t[s+L .. s+19]),
-    /// for all 20 starts and the lengths 4..8 at once, without a branch.
+    /// circle_fires<20, 4, 8> with the pixels at centre[offsets[k]].
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle20_fires(const std::int64_t* centre,
                                                                            const std::int64_t* offsets) noexcept {
-        const std::int64_t* o = offsets;
         std::int64_t p[20];
-        for (int k = 0; k < 20; ++k) p[k] = centre[o[k]];
-        const V20 t{{_mm512_set_epi64(p[7], p[6], p[5], p[4], p[3], p[2], p[1], p[0]),
-                     _mm512_set_epi64(p[15], p[14], p[13], p[12], p[11], p[10], p[9], p[8]),
-                     _mm512_set_epi64(p[3], p[2], p[1], p[0], p[19], p[18], p[17], p[16]),
-                     _mm512_set_epi64(p[11], p[10], p[9], p[8], p[7], p[6], p[5], p[4])}};
-        const V20 r1 = rot20<1>(t), r2 = rot20<2>(t), r4 = rot20<4>(t);
-        // wL[s] = min(t[s .. s+L-1]).
-        const V20 w2 = vmin(t, r1);
-        const V20 w3 = vmin(w2, r2);
-        const V20 w4 = vmin(w2, rot20<2>(w2));
-        const V20 w5 = vmin(w4, r4);
-        const V20 w6 = vmin(w4, rot20<4>(w2));
-        const V20 w7 = vmin(w4, rot20<4>(w3));
-        const V20 w8 = vmin(w4, rot20<4>(w4));
-        // xM[s] = max(t[s .. s+M-1]); the rest of the arc (L, s) is x(20-L)[s+L].
-        const V20 x2 = vmax(t, r1);
-        const V20 x3 = vmax(x2, r2);
-        const V20 x4 = vmax(x2, rot20<2>(x2));
-        const V20 x5 = vmax(x4, r4);
-        const V20 x6 = vmax(x4, rot20<4>(x2));
-        const V20 x7 = vmax(x4, rot20<4>(x3));
-        const V20 x8 = vmax(x4, rot20<4>(x4));
-        const unsigned fires = any_greater(w4, rot20<4>(vmax(x8, rot20<8>(x8)))) |   // rest of 16
-                               any_greater(w5, rot20<5>(vmax(x8, rot20<8>(x7)))) |   // rest of 15
-                               any_greater(w6, rot20<6>(vmax(x8, rot20<8>(x6)))) |   // rest of 14
-                               any_greater(w7, rot20<7>(vmax(x8, rot20<8>(x5)))) |   // rest of 13
-                               any_greater(w8, rot20<8>(vmax(x8, rot20<8>(x4))));    // rest of 12
-        return fires != 0;
+        for (int k = 0; k < 20; ++k) p[k] = centre[offsets[k]];
+        const Circle20 t{{_mm512_set_epi64(p[7], p[6], p[5], p[4], p[3], p[2], p[1], p[0]),
+                          _mm512_set_epi64(p[15], p[14], p[13], p[12], p[11], p[10], p[9], p[8]),
+                          _mm512_set_epi64(p[3], p[2], p[1], p[0], p[19], p[18], p[17], p[16]),
+                          _mm512_set_epi64(p[11], p[10], p[9], p[8], p[7], p[6], p[5], p[4])}};
+        return fires<20, 4, 8>(t);
     }
 };
+#pragma GCC diagnostic pop
 #endif
 
 /// Gathers the circle around `centre` (pixel k at centre[offset(k)]) and runs the test.
