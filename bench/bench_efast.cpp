@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
             per_file(s, *ev,
                      [] {
                          return std::make_unique<ParallelDetector<EFast>>(kDavis240, 2, kCircleMargin,
-                                                                          [](SensorSize s) { return EFast(s); });
+                                                                          [](SensorSize s, int planes) { return EFast(s, planes); });
                      },
                      [](ParallelDetector<EFast>& d, const std::vector<Event>& e, std::vector<std::uint8_t>& f) {
                          return d.detect(e, f);

@@ -23,10 +23,10 @@ HarrisParams validated(HarrisParams p) {
 
 }  // namespace
 
-Harris::Harris(SensorSize size, HarrisParams params)
+Harris::Harris(SensorSize size, HarrisParams params, int planes)
     : params_(validated(params)),
       scorer_(params_.window, params_.k),
-      sae_(size, params_.window / 2),
+      sae_(size, params_.window / 2, planes),
       radius_(params_.window / 2) {}
 
 bool Harris::process(const Event& e) noexcept {

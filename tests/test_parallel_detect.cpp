@@ -52,7 +52,7 @@ std::vector<Event> random_stream(SensorSize s, std::size_t n, std::uint32_t seed
 template <class D, class Make>
 void expect_same_as_one_thread(const std::vector<Event>& events, SensorSize s, int radius, Make make,
                                std::size_t batch, bool need_corners = true) {
-    D one = make(s);
+    D one = make(s, 2);
     std::vector<std::uint8_t> expected(events.size());
     const std::size_t corners = detect(one, std::span<const Event>(events), expected);
     if (need_corners) {
@@ -100,27 +100,27 @@ TEST(ParallelDetect, EFastRandomHdStreams) {
     for (std::uint32_t seed = 1; seed <= 3; ++seed) {
         SCOPED_TRACE(seed);
         const auto events = random_stream(hd, 300000, seed);
-        expect_same_as_one_thread<EFast>(events, hd, kCircleMargin, [](SensorSize z) { return EFast(z); }, 70000);
+        expect_same_as_one_thread<EFast>(events, hd, kCircleMargin, [](SensorSize z, int planes) { return EFast(z, planes); }, 70000);
     }
 }
 
 TEST(ParallelDetect, EFastSmallSensors) {
     for (const SensorSize s : {SensorSize{9, 9}, SensorSize{17, 11}, SensorSize{64, 48}}) {
         const auto events = random_stream(s, 40000, 11);
-        expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [](SensorSize z) { return EFast(z); }, 4096,
+        expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [](SensorSize z, int planes) { return EFast(z, planes); }, 4096,
                                          /*need_corners=*/s.width > 32);
     }
 }
 
 TEST(ParallelDetect, EFastBundledSample) {
     const auto events = io::read_text_file((test::bundled_data() / "ecd/shapes_translation/events.txt").string());
-    expect_same_as_one_thread<EFast>(events, kDavis240, kCircleMargin, [](SensorSize z) { return EFast(z); }, 1 << 16);
+    expect_same_as_one_thread<EFast>(events, kDavis240, kCircleMargin, [](SensorSize z, int planes) { return EFast(z, planes); }, 1 << 16);
 }
 
 TEST(ParallelDetect, HarrisRandomHdStream) {
     const SensorSize hd{1280, 720};
     const auto events = random_stream(hd, 40000, 5);
-    expect_same_as_one_thread<Harris>(events, hd, HarrisParams{}.window / 2, [](SensorSize z) { return Harris(z); }, 9000);
+    expect_same_as_one_thread<Harris>(events, hd, HarrisParams{}.window / 2, [](SensorSize z, int planes) { return Harris(z, {}, planes); }, 9000);
 }
 
 TEST(ParallelDetect, BatchesThatLeavePartsEmpty) {
@@ -134,7 +134,31 @@ TEST(ParallelDetect, BatchesThatLeavePartsEmpty) {
         t += static_cast<std::int64_t>(rng() % 2);
         events.push_back({t, static_cast<std::uint16_t>(20 + rng() % 40), static_cast<std::uint16_t>(30 + rng() % 12), 1});
     }
-    expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [](SensorSize z) { return EFast(z); }, 20000);
+    expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [](SensorSize z, int planes) { return EFast(z, planes); }, 20000);
+}
+
+TEST(ParallelDetect, OnePlaneDetectorsMatchOnOnePolarity) {
+    // A part sees one polarity and keeps one state plane: on such a stream, the same flags
+    // as the two-plane detector, at half the state.
+    const SensorSize s{240, 180};
+    std::vector<Event> events;
+    for (const Event& e : random_stream(s, 60000, 31))
+        if (e.p == 1) events.push_back(e);
+    std::vector<std::uint8_t> two(events.size()), one(events.size());
+    {
+        EFast a(s), b(s, 1);
+        EXPECT_GT(detect(a, std::span<const Event>(events), two), 0u);
+        detect(b, std::span<const Event>(events), one);
+        EXPECT_EQ(one, two);
+        EXPECT_EQ(2 * b.memory_bytes(), a.memory_bytes());
+    }
+    {
+        Harris a(s), b(s, {}, 1);
+        EXPECT_GT(detect(a, std::span<const Event>(events), two), 0u);
+        detect(b, std::span<const Event>(events), one);
+        EXPECT_EQ(one, two);
+        EXPECT_EQ(2 * b.memory_bytes(), a.memory_bytes());
+    }
 }
 
 TEST(ParallelDetect, BandsSplitEachPolarityEvenly) {
@@ -183,7 +207,7 @@ TEST(ParallelDetect, AnErrorAlongsideComesAfterTheBatch) {
     EFast one(s);
     std::vector<std::uint8_t> expected(events.size());
     detect(one, std::span<const Event>(events), expected);
-    ParallelDetector<EFast> par(s, 2, kCircleMargin, [](SensorSize z) { return EFast(z); });
+    ParallelDetector<EFast> par(s, 2, kCircleMargin, [](SensorSize z, int planes) { return EFast(z, planes); });
     par.prepare(events);
     std::vector<std::uint8_t> got(events.size(), 7);
     EXPECT_THROW(par.run(got, [] { throw std::runtime_error("read failed"); }), std::runtime_error);

@@ -301,11 +301,11 @@ Row bench_parallel(const std::string& input, const std::string& name, int thread
         }
     };
     if (name == "efast") {
-        passes([&] { return std::make_unique<ParallelDetector<EFast>>(sensor, threads, kCircleMargin, [](SensorSize s) { return EFast(s); }); });
+        passes([&] { return std::make_unique<ParallelDetector<EFast>>(sensor, threads, kCircleMargin, [](SensorSize s, int planes) { return EFast(s, planes); }); });
     } else if (name == "harris") {
         passes([&] {
             return std::make_unique<ParallelDetector<Harris>>(sensor, threads, HarrisParams{}.window / 2,
-                                                              [](SensorSize s) { return Harris(s); });
+                                                              [](SensorSize s, int planes) { return Harris(s, {}, planes); });
         });
     } else {
         throw std::invalid_argument("--threads: detector '" + name + "' is not local (efast and harris are)");

@@ -281,11 +281,11 @@ void run_detect(const DetectOptions& o) {
         if (o.threads > 1) {
             // Local detectors only: the sensor splits into parts (parallel_detect.hpp).
             if (o.detector == "efast") {
-                ParallelDetector<EFast> par(size, o.threads, kCircleMargin, [](SensorSize s) { return EFast(s); });
+                ParallelDetector<EFast> par(size, o.threads, kCircleMargin, [](SensorSize s, int planes) { return EFast(s, planes); });
                 run_parallel(par);
             } else {
                 const HarrisParams hp = o.params.harris;
-                ParallelDetector<Harris> par(size, o.threads, hp.window / 2, [hp](SensorSize s) { return Harris(s, hp); });
+                ParallelDetector<Harris> par(size, o.threads, hp.window / 2, [hp](SensorSize s, int planes) { return Harris(s, hp, planes); });
                 run_parallel(par);
             }
         } else {

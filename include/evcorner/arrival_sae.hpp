@@ -19,12 +19,15 @@ namespace evcorner {
 
 class ArrivalSae {
 public:
-    ArrivalSae(SensorSize size, int pad)
+    /// `planes` = 2: one plane per polarity; 1: one plane both polarities share (for a
+    /// caller that feeds one polarity only).
+    ArrivalSae(SensorSize size, int pad, int planes = 2)
         : size_(size),
           pad_(pad),
+          planes_(planes == 1 ? 1 : 2),
           stride_(static_cast<std::size_t>(size.width) + 2 * static_cast<std::size_t>(pad)),
           plane_size_(stride_ * (static_cast<std::size_t>(size.height) + 2 * static_cast<std::size_t>(pad))),
-          cells_(2 * plane_size_, 0) {}
+          cells_(static_cast<std::size_t>(planes_) * plane_size_, 0) {}
 
     [[nodiscard]] SensorSize size() const noexcept { return size_; }
     [[nodiscard]] int pad() const noexcept { return pad_; }
@@ -36,13 +39,13 @@ public:
         return (static_cast<std::size_t>(y) + pad_) * stride_ + static_cast<std::size_t>(x) + pad_;
     }
     [[nodiscard]] const std::uint64_t* plane(int p) const noexcept {
-        return cells_.data() + static_cast<std::size_t>(p) * plane_size_;
+        return cells_.data() + static_cast<std::size_t>(p != 0 && planes_ == 2) * plane_size_;
     }
     [[nodiscard]] std::uint64_t at(int p, int x, int y) const noexcept { return plane(p)[index(x, y)]; }
 
     /// Stamps `e` with the next sequence number and returns it.
     std::uint64_t update(const Event& e) noexcept {
-        cells_[static_cast<std::size_t>(e.p != 0) * plane_size_ + index(e.x, e.y)] = ++last_;
+        cells_[static_cast<std::size_t>(e.p != 0 && planes_ == 2) * plane_size_ + index(e.x, e.y)] = ++last_;
         return last_;
     }
     /// The sequence number of the latest event (0 before the first).
@@ -55,6 +58,7 @@ public:
 private:
     SensorSize size_;
     int pad_;
+    int planes_;
     std::size_t stride_;
     std::size_t plane_size_;
     std::vector<std::uint64_t> cells_;

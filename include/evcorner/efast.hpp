@@ -30,7 +30,9 @@ public:
     static constexpr int kArc3Min = 3, kArc3Max = 6;
     static constexpr int kArc4Min = 4, kArc4Max = 8;
 
-    explicit EFast(SensorSize size) : sae_(size) {}
+    /// `planes` = 1 keeps one SAE plane for both polarities: only for a caller that feeds
+    /// events of one polarity (ParallelDetector's parts), at half the memory.
+    explicit EFast(SensorSize size, int planes = 2) : sae_(size, planes) {}
 
     /// Updates the SAE with `e` and answers whether `e` is a corner event.
     /// `e` must lie on the sensor (readers validate).

@@ -32,7 +32,9 @@ struct HarrisParams {
 class Harris {
 public:
     /// Throws std::invalid_argument for a parameter out of range (the message names it).
-    explicit Harris(SensorSize size, HarrisParams params = {});
+    /// `planes` = 1 keeps one plane of state for both polarities: only for a caller that
+    /// feeds events of one polarity (ParallelDetector's parts), at half the memory.
+    explicit Harris(SensorSize size, HarrisParams params = {}, int planes = 2);
 
     /// Updates the state with `e` and answers whether `e` is a corner event.
     /// `e` must lie on the sensor (readers validate).

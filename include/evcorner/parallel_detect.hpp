@@ -5,7 +5,8 @@
 // the earlier events of e's polarity within r pixels of e (eFAST: r = 4, the radius-4
 // circle; Harris: half its window). Then the sensor splits into parts, each a band of
 // rows [y0, y1) of one polarity p: a part keeps its own detector, over a sensor of just
-// the rows [y0 - r, y1 + r) (the band and its halo, clipped to the sensor), feeds it, in
+// the rows [y0 - r, y1 + r) (the band and its halo, clipped to the sensor) and with one
+// state plane (it sees one polarity), feeds it, in
 // input order, every event of polarity p in those rows, and keeps its answers only for
 // the events of its band. Each event is classified by exactly one part, from a state
 // identical to that of a single detector run over the whole stream (the border rule
@@ -95,13 +96,15 @@ public:
     /// Most events a prepare() takes at once.
     static constexpr std::size_t kMaxBatch = std::size_t{1} << 16;
 
-    /// `make(SensorSize)` builds one detector for a part's rows; `radius` is the
-    /// detector's locality; `parts_per_thread` parts per thread are handed out per batch.
+    /// `make(SensorSize, planes)` builds one detector: over the whole sensor with one state
+    /// plane per polarity (planes = 2) for a single thread, or over a part's rows with one
+    /// plane (planes = 1: a part sees one polarity). `radius` is the detector's locality;
+    /// `parts_per_thread` parts per thread are handed out per batch.
     template <class Make>
     ParallelDetector(SensorSize size, int threads, int radius, Make make, int parts_per_thread = 4)
         : size_(size), radius_(radius), parts_per_thread_(std::max(1, parts_per_thread)),
           pool_(std::max(1, threads)), make_(std::move(make)) {
-        if (pool_.size() == 1) single_ = std::make_unique<D>(make_(size_));
+        if (pool_.size() == 1) single_ = std::make_unique<D>(make_(size_, 2));
     }
 
     [[nodiscard]] int threads() const noexcept { return pool_.size(); }
@@ -217,7 +220,7 @@ private:
             for (int y = d.lo; y < d.hi; ++y)
                 if (y < d.y0 || y >= d.y1) halo_of_[static_cast<std::size_t>(d.p) * H + static_cast<std::size_t>(y)] = static_cast<std::uint16_t>(j);
             Part part;
-            part.detector = std::make_unique<D>(make_(SensorSize{size_.width, d.hi - d.lo}));
+            part.detector = std::make_unique<D>(make_(SensorSize{size_.width, d.hi - d.lo}, 1));
             part.lo = d.lo;
             part.flags.reserve(kMaxBatch);
             part.corners.reserve(kMaxBatch);
@@ -297,7 +300,7 @@ private:
     int radius_;
     int parts_per_thread_;
     WorkerPool pool_;
-    std::function<D(SensorSize)> make_;
+    std::function<D(SensorSize, int)> make_;
     std::unique_ptr<D> single_;
     std::vector<DetectPart> plan_;
     std::vector<Part> parts_;

@@ -16,18 +16,23 @@ class Sae {
 public:
     static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
 
-    explicit Sae(SensorSize size)
-        : size_(size), cells_(static_cast<std::size_t>(2 * size.pixels()), kNever) {}
+    /// `planes` = 2: one plane per polarity. 1: a single plane that both polarities
+    /// share, for a caller that feeds events of one polarity only (half the memory).
+    explicit Sae(SensorSize size, int planes = 2)
+        : size_(size), planes_(planes == 1 ? 1 : 2),
+          cells_(static_cast<std::size_t>(planes_) * static_cast<std::size_t>(size.pixels()), kNever) {}
 
     [[nodiscard]] SensorSize size() const noexcept { return size_; }
 
     /// Row-major plane of one polarity: plane(p)[y * width + x].
     [[nodiscard]] const std::int64_t* plane(int p) const noexcept {
-        return cells_.data() + static_cast<std::size_t>(p) * plane_size();
+        return cells_.data() + static_cast<std::size_t>(p != 0 && planes_ == 2) * plane_size();
     }
     [[nodiscard]] std::int64_t* plane(int p) noexcept {
-        return cells_.data() + static_cast<std::size_t>(p) * plane_size();
+        return cells_.data() + static_cast<std::size_t>(p != 0 && planes_ == 2) * plane_size();
     }
+    /// 2, or 1 when both polarities share one plane.
+    [[nodiscard]] int planes() const noexcept { return planes_; }
     [[nodiscard]] std::int64_t at(int p, int x, int y) const noexcept {
         return plane(p)[static_cast<std::size_t>(y) * size_.width + x];
     }
@@ -46,6 +51,7 @@ private:
     }
 
     SensorSize size_;
+    int planes_;
     std::vector<std::int64_t> cells_;
 };
 
