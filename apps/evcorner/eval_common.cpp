@@ -16,12 +16,7 @@ LoadedEvents load_events(const std::string& path, const InputOptions& o) {
     ropts.csv_time_unit = o.time_unit;
     const auto reader = io::open_event_reader(path, ropts, o.format);
     LoadedEvents out;
-    std::vector<Event> buf(1 << 16);
-    for (;;) {
-        const std::size_t n = reader->read(buf);
-        if (n == 0 && reader->skipped_in_batch().empty()) break;
-        out.events.insert(out.events.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
-    }
+    out.events = io::read_all_events(*reader);
     out.size = reader->sensor().value_or(kDavis240);
     return out;
 }

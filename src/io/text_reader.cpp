@@ -132,10 +132,7 @@ std::size_t TextReader::read(std::span<Event> out) {
 
 std::vector<Event> read_text_file(const std::string& path, ReaderOptions options) {
     TextReader reader(path, options);
-    std::vector<Event> all;
-    std::vector<Event> chunk(1 << 16);
-    while (const std::size_t n = reader.read(chunk)) all.insert(all.end(), chunk.begin(), chunk.begin() + n);
-    return all;
+    return read_all_events(reader);
 }
 
 }  // namespace evcorner::io

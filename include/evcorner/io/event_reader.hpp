@@ -13,6 +13,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "evcorner/event.hpp"
 #include "evcorner/sensor.hpp"
@@ -61,5 +62,17 @@ public:
     [[nodiscard]] virtual std::uint64_t bytes_consumed() const noexcept = 0;
     [[nodiscard]] virtual std::optional<std::uint64_t> bytes_total() const noexcept = 0;
 };
+
+/// The whole stream into memory (tools and tests that need every event at once), read
+/// by the contract: batches until one is empty with no skip runs. Throws InputError.
+inline std::vector<Event> read_all_events(EventReader& reader) {
+    std::vector<Event> all;
+    std::vector<Event> batch(std::size_t{1} << 16);
+    for (;;) {
+        const std::size_t n = reader.read(batch);
+        if (n == 0 && reader.skipped_in_batch().empty()) return all;
+        all.insert(all.end(), batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+}
 
 }  // namespace evcorner::io
