@@ -35,9 +35,9 @@
 #endif
 
 #include "commands.hpp"
+#include "eval_common.hpp"
 #include "evcorner/any_detector.hpp"
 #include "evcorner/detector.hpp"
-#include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/parallel_detect.hpp"
 
@@ -60,10 +60,7 @@ struct BenchOptions {
     int repeat = 5;
     std::uint64_t min_events = 10'000'000;
     std::string json;
-    std::string format = "auto";
-    std::string csv_columns;
-    std::string time_unit = "us";
-    std::string size;
+    InputOptions in;
     std::string threads = "1";
     bool no_latency = false;
     bool quiet = false;
@@ -117,23 +114,6 @@ std::string compiler() {
 }
 
 // ----------------------------------------------------------------- input
-
-std::vector<Event> load(const std::string& path, const BenchOptions& o, SensorSize& sensor) {
-    io::ReaderOptions ropts;
-    if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
-    ropts.csv_columns = o.csv_columns;
-    ropts.csv_time_unit = o.time_unit;
-    auto reader = io::open_event_reader(path, ropts, o.format);
-    std::vector<Event> events;
-    std::vector<Event> batch(1 << 16);
-    for (;;) {
-        const std::size_t n = reader->read(batch);
-        if (n == 0 && reader->skipped_in_batch().empty()) break;
-        events.insert(events.end(), batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(n));
-    }
-    sensor = reader->sensor().value_or(kDavis240);
-    return events;
-}
 
 /// The file's events repeated until there are at least `min_events`, each repetition
 /// shifted in time past the previous one.
@@ -237,32 +217,47 @@ Latency time_each_event(D& det, const std::vector<Event>& events) {
     return out;
 }
 
-Row bench_one(const std::string& input, const std::string& name, SensorSize sensor,
-              const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
-              Latency& clock) {
+// A row of `repeat` throughput passes over `events`. pass(row, flags) builds a fresh
+// detector, runs it over the stream inside `time(...)`, and sets the row's corners and
+// memory; the row gets ns/event per pass and their median, min and max.
+template <class Pass>
+Row timed_passes(const std::string& input, const std::string& name, int threads, SensorSize sensor,
+                 const std::vector<Event>& events, std::uint64_t file_events, int repeat, Pass pass) {
     Row row;
     row.input = input;
     row.detector = name;
+    row.threads = threads;
     row.sensor = sensor;
     row.file_events = file_events;
     row.events = events.size();
     std::vector<std::uint8_t> flags(events.size());
     const double n = static_cast<double>(events.size());
-    for (int r = 0; r < o.repeat; ++r) {
-        AnyDetector any = make_detector(name, sensor);
-        row.memory = memory_bytes(any);
-        std::visit(
-            [&](auto& det) {
-                const auto t0 = Clock::now();
-                row.corners = detect(det, std::span<const Event>(events), flags);
-                const auto t1 = Clock::now();
-                row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / n);
-            },
-            any);
+    for (int r = 0; r < repeat; ++r) {
+        pass(row, flags, [&](auto&& run) {
+            const auto t0 = Clock::now();
+            run();
+            row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / n);
+        });
     }
     row.median = median_of(row.ns_per_event);
     row.min = *std::min_element(row.ns_per_event.begin(), row.ns_per_event.end());
     row.max = *std::max_element(row.ns_per_event.begin(), row.ns_per_event.end());
+    return row;
+}
+
+Row bench_one(const std::string& input, const std::string& name, SensorSize sensor,
+              const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
+              Latency& clock) {
+    Row row = timed_passes(input, name, 1, sensor, events, file_events, o.repeat,
+                           [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
+                               AnyDetector any = make_detector(name, sensor);
+                               r.memory = memory_bytes(any);
+                               std::visit(
+                                   [&](auto& det) {
+                                       time([&] { r.corners = detect(det, std::span<const Event>(events), flags); });
+                                   },
+                                   any);
+                           });
     if (!o.no_latency) {
         AnyDetector any = make_detector(name, sensor);
         std::visit(
@@ -281,39 +276,25 @@ Row bench_one(const std::string& input, const std::string& name, SensorSize sens
 /// Throughput passes with the sensor split over `threads` threads (parallel_detect.hpp).
 Row bench_parallel(const std::string& input, const std::string& name, int threads, SensorSize sensor,
                    const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o) {
-    Row row;
-    row.input = input;
-    row.detector = name;
-    row.threads = threads;
-    row.sensor = sensor;
-    row.file_events = file_events;
-    row.events = events.size();
-    std::vector<std::uint8_t> flags(events.size());
-    const double n = static_cast<double>(events.size());
     auto passes = [&](auto make_par) {
-        for (int r = 0; r < o.repeat; ++r) {
-            auto par = make_par();  // threads started outside the timing
-            const auto t0 = Clock::now();
-            row.corners = par->detect(std::span<const Event>(events), flags);
-            const auto t1 = Clock::now();
-            row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / n);
-            row.memory = par->memory_bytes([](const auto& d) { return d.memory_bytes(); });
-        }
+        return timed_passes(input, name, threads, sensor, events, file_events, o.repeat,
+                            [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
+                                auto par = make_par();  // threads started outside the timing
+                                time([&] { r.corners = par->detect(std::span<const Event>(events), flags); });
+                                r.memory = par->memory_bytes([](const auto& d) { return d.memory_bytes(); });
+                            });
     };
-    if (name == "efast") {
-        passes([&] { return std::make_unique<ParallelDetector<EFast>>(sensor, threads, kCircleMargin, [](SensorSize s, int planes) { return EFast(s, planes); }); });
-    } else if (name == "harris") {
-        passes([&] {
+    if (name == "efast")
+        return passes([&] {
+            return std::make_unique<ParallelDetector<EFast>>(sensor, threads, kCircleMargin,
+                                                             [](SensorSize s, int planes) { return EFast(s, planes); });
+        });
+    if (name == "harris")
+        return passes([&] {
             return std::make_unique<ParallelDetector<Harris>>(sensor, threads, HarrisParams{}.window / 2,
                                                               [](SensorSize s, int planes) { return Harris(s, {}, planes); });
         });
-    } else {
-        throw std::invalid_argument("--threads: detector '" + name + "' is not local (efast and harris are)");
-    }
-    row.median = median_of(row.ns_per_event);
-    row.min = *std::min_element(row.ns_per_event.begin(), row.ns_per_event.end());
-    row.max = *std::max_element(row.ns_per_event.begin(), row.ns_per_event.end());
-    return row;
+    throw std::invalid_argument("--threads: detector '" + name + "' is not local (efast and harris are)");
 }
 
 // ----------------------------------------------------------------- report
@@ -457,9 +438,10 @@ void run_bench(const BenchOptions& o) {
         std::vector<Event> stream;
         std::uint64_t file_events = 0;
         {
-            const std::vector<Event> file = load(input, o, sensor);
-            file_events = file.size();
-            stream = replay(file, o.min_events);
+            LoadedEvents file = load_events(input, o.in);
+            sensor = file.size;
+            file_events = file.events.size();
+            stream = replay(file.events, o.min_events);
         }
         if (stream.empty()) {
             fmt::print(stderr, "evcorner bench: {}: no events, skipped\n", input);
@@ -503,11 +485,7 @@ void add_bench_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
     cmd->add_option("--json", o->json, "Also write every figure as JSON to this file (- = standard output)");
-    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
-    cmd->add_option("--size", o->size, "Sensor size WxH [default: the file's own, else 240x180]")
-        ->check([](const std::string& s) {
-            return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
-        });
+    add_load_options(*cmd, o->in);
     cmd->add_option("--threads", o->threads,
                     "Comma-separated thread counts, e.g. 1,2: efast and harris also run split over that many "
                     "threads (parallel_detect.hpp; no latency pass); others run on one")
