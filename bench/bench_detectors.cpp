@@ -13,7 +13,7 @@
 #include "evcorner/efast.hpp"
 #include "evcorner/harris.hpp"
 #include "evcorner/harris_global.hpp"
-#include "evcorner/io/text_reader.hpp"
+#include "real_files.hpp"
 
 namespace fs = std::filesystem;
 using namespace evcorner;
@@ -25,19 +25,14 @@ struct Input {
     std::vector<Event> events;
 };
 
+// The nine Event-Camera-Dataset cuts, else the bundled one.
 std::vector<Input> load_inputs() {
     std::vector<Input> inputs;
-    const fs::path real = fs::path(EVCORNER_SHARED_DIR) / "data" / "real";
-    if (fs::is_directory(real / "ecd-stppp")) {
-        for (const char* seq : {"boxes_rotation", "boxes_translation", "dynamic_rotation", "dynamic_translation",
-                                "poster_rotation", "poster_translation", "shapes_rotation", "shapes_translation"})
-            inputs.push_back({seq, io::read_text_file((real / "ecd-stppp" / seq / "events.txt").string())});
-        inputs.push_back({"slider_depth",
-                          io::read_text_file((real / "ecd-slider-depth-eventsviz/slider_depth/events_chunk.txt").string())});
-    } else {
+    for (const auto& f : bench::real_240x180_files(fs::path(EVCORNER_SHARED_DIR) / "data"))
+        if (f.ecd) inputs.push_back({f.name, bench::load_events(f.events)});
+    if (inputs.empty())
         inputs.push_back({"bundled_shapes_translation",
-                          io::read_text_file((fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt").string())});
-    }
+                          bench::load_events(fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt")});
     return inputs;
 }
 

@@ -15,7 +15,7 @@
 
 #include "evcorner/detector.hpp"
 #include "evcorner/efast.hpp"
-#include "evcorner/io/open.hpp"
+#include "real_files.hpp"
 #include "evcorner/parallel_detect.hpp"
 
 namespace fs = std::filesystem;
@@ -23,32 +23,15 @@ using namespace evcorner;
 
 namespace {
 
-std::vector<fs::path> real_files() {
-    std::vector<fs::path> files;
-    const fs::path shared = fs::path(EVCORNER_SHARED_DIR) / "data/real";
-    if (fs::is_directory(shared / "ecd-stppp")) {
-        for (const char* seq : {"boxes_rotation", "boxes_translation", "dynamic_rotation",
-                                "dynamic_translation", "poster_rotation", "poster_translation",
-                                "shapes_rotation", "shapes_translation"})
-            files.push_back(shared / "ecd-stppp" / seq / "events.txt");
-        files.push_back(shared / "ecd-slider-depth-eventsviz/slider_depth/events_chunk.txt");
-        files.push_back(shared / "davis240c-imu-pyaedattools/IMU_rotDisk.aedat");
-        files.push_back(shared / "davis240c-imu-pyaedattools/IMU_translBoxes.aedat");
-    } else {
-        files.push_back(fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt");
-    }
-    return files;
-}
-
-std::vector<Event> load(const fs::path& f) {
-    auto reader = io::open_event_reader(f.string());
-    std::vector<Event> events, batch(1 << 16);
-    for (std::size_t n; (n = reader->read(batch)) > 0;) events.insert(events.end(), batch.begin(), batch.begin() + n);
-    return events;
-}
-
-std::string short_name(const fs::path& f) {
-    return f.extension() == ".aedat" ? f.stem().string() : f.parent_path().filename().string();
+// The 11 real files, else the bundled cut: (name, events).
+std::vector<std::pair<std::string, std::vector<Event>>> load_inputs() {
+    std::vector<std::pair<std::string, std::vector<Event>>> inputs;
+    for (const auto& f : bench::real_240x180_files(fs::path(EVCORNER_SHARED_DIR) / "data"))
+        inputs.emplace_back(f.name, bench::load_events(f.events));
+    if (inputs.empty())
+        inputs.emplace_back("shapes_translation",
+                            bench::load_events(fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt"));
+    return inputs;
 }
 
 // run(det, events, flags) once per iteration on a fresh detector from make().
@@ -73,13 +56,9 @@ void per_file(benchmark::State& state, const std::vector<Event>& events, Make ma
 }  // namespace
 
 int main(int argc, char** argv) {
-    static std::vector<std::vector<Event>> loaded;
-    const auto files = real_files();
-    loaded.reserve(files.size());
-    for (const auto& f : files) loaded.push_back(load(f));
-    for (std::size_t i = 0; i < files.size(); ++i) {
-        const std::string name = short_name(files[i]);
-        const std::vector<Event>* ev = &loaded[i];
+    static const auto loaded = load_inputs();
+    for (const auto& [name, events] : loaded) {
+        const std::vector<Event>* ev = &events;
         benchmark::RegisterBenchmark(("efast/" + name).c_str(), [ev](benchmark::State& s) {
             per_file(s, *ev, [] { return std::make_unique<EFast>(kDavis240); },
                      [](EFast& d, const std::vector<Event>& e, std::vector<std::uint8_t>& f) {

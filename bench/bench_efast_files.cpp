@@ -16,7 +16,7 @@
 
 #include "evcorner/detector.hpp"
 #include "evcorner/efast.hpp"
-#include "evcorner/io/open.hpp"
+#include "real_files.hpp"
 
 namespace fs = std::filesystem;
 using namespace evcorner;
@@ -30,12 +30,9 @@ struct File {
     std::vector<double> ns;
 };
 
-File load(const std::string& name, const fs::path& events, const fs::path& golden) {
-    File f{name, {}, {}, {}};
-    auto reader = io::open_event_reader(events.string());
-    std::vector<Event> batch(1 << 16);
-    for (std::size_t n; (n = reader->read(batch)) > 0;) f.events.insert(f.events.end(), batch.begin(), batch.begin() + n);
-    std::ifstream in(golden);
+File load(const bench::RealFile& r) {
+    File f{r.name, bench::load_events(r.events), {}, {}};
+    std::ifstream in(r.golden);
     for (std::size_t i; in >> i;) f.golden.push_back(i);
     return f;
 }
@@ -50,20 +47,13 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
     const int passes = argc > 1 ? std::max(1, std::atoi(argv[1])) : 41;
     const fs::path data = fs::path(EVCORNER_SHARED_DIR) / "data";
-    if (!fs::is_directory(data / "golden")) {
+    const auto real = bench::real_240x180_files(data);
+    if (real.empty() || !fs::is_directory(data / "golden")) {
         std::fprintf(stderr, "bench_efast_files: %s not found\n", data.string().c_str());
         return 1;
     }
     std::vector<File> files;
-    for (const char* seq : {"boxes_rotation", "boxes_translation", "dynamic_rotation", "dynamic_translation",
-                            "poster_rotation", "poster_translation", "shapes_rotation", "shapes_translation"})
-        files.push_back(load(seq, data / "real/ecd-stppp" / seq / "events.txt",
-                             data / "golden" / (std::string("ecd-stppp.") + seq + ".efast.idx")));
-    files.push_back(load("slider_depth", data / "real/ecd-slider-depth-eventsviz/slider_depth/events_chunk.txt",
-                         data / "golden/ecd-slider-depth-eventsviz.slider_depth.efast.idx"));
-    for (const char* rec : {"IMU_rotDisk", "IMU_translBoxes"})
-        files.push_back(load(rec, data / "real/davis240c-imu-pyaedattools" / (std::string(rec) + ".aedat"),
-                             data / "golden" / (std::string("davis240c-imu-pyaedattools.") + rec + ".efast.idx")));
+    for (const auto& r : real) files.push_back(load(r));
 
     bool golden_ok = true;
     for (int pass = 0; pass < passes; ++pass) {
