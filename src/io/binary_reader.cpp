@@ -76,35 +76,23 @@ void BinaryReader::fail(std::uint64_t at, const std::string& reason) const {
 }
 
 void BinaryReader::outside(std::uint32_t x, std::uint32_t y, std::uint64_t at) {
-    if (!options_.skip_invalid) {
-        if (sensor_)
-            fail(at, fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, "
-                                 "or --skip-invalid to skip such events)",
-                                 x, y, sensor_->width, sensor_->height));
-        fail(at, fmt::format("event at x={} y={} does not fit 16-bit coordinates", x, y));
-    }
-    ++skipped_;
-    if (!skipped_in_batch_.empty() && skipped_in_batch_.back().before == n_)
-        ++skipped_in_batch_.back().count;  // one run per gap: memory stays bounded
-    else
-        skipped_in_batch_.push_back({n_, 1});
+    if (!options_.skip_invalid) fail(at, outside_sensor_message(x, y, sensor_));
+    skips_.skip(n_);
 }
 
 void BinaryReader::backwards(std::int64_t t, std::uint64_t at) const {
-    // In unsigned arithmetic: the gap between two int64 times can exceed INT64_MAX.
-    const std::uint64_t gap = static_cast<std::uint64_t>(last_t_) - static_cast<std::uint64_t>(t);
-    fail(at, fmt::format("timestamp goes backwards ({} us before the previous event)", gap));
+    fail(at, backwards_message(last_t_, t));
 }
 
 std::size_t BinaryReader::read(std::span<Event> out) {
-    skipped_in_batch_.clear();
+    skips_.new_batch();
     if (error_) std::rethrow_exception(error_);
     if (done_ || out.empty()) return 0;
     out_ = out;
     n_ = 0;
     try {
         // A batch of skipped events only still returns, so that skip runs stay bounded.
-        while (n_ < out_.size() && skipped_in_batch_.size() < out_.size()) {
+        while (n_ < out_.size() && skips_.batch().size() < out_.size()) {
             if (!decode()) {
                 done_ = true;
                 break;
@@ -112,7 +100,7 @@ std::size_t BinaryReader::read(std::span<Event> out) {
         }
     } catch (const InputError&) {
         error_ = std::current_exception();
-        if (n_ == 0 && skipped_in_batch_.empty()) throw;
+        if (n_ == 0 && skips_.batch().empty()) throw;
     }
     events_ += n_;
     return n_;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
-#include <fmt/format.h>
 #include <utility>
 
 #include "evcorner/error.hpp"
@@ -156,7 +155,7 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
 }
 
 std::size_t CsvReader::read(std::span<Event> out) {
-    skipped_in_batch_.clear();
+    skips_.new_batch();
     if (error_) std::rethrow_exception(error_);
     std::size_t n = 0;
     try {
@@ -178,18 +177,10 @@ std::size_t CsvReader::read(std::span<Event> out) {
             Event ev{};
             const char* why = nullptr;
             if (!parse(b, e, ev, why)) lines_.fail(b, e, why);
-            if (ev.t < last_t_)
-                lines_.fail(b, e, fmt::format("timestamp goes backwards ({} us before the previous event)", last_t_ - ev.t));
+            if (ev.t < last_t_) lines_.fail(b, e, backwards_message(last_t_, ev.t));
             if (sensor_ && !sensor_->contains(ev)) {
-                if (!options_.skip_invalid)
-                    lines_.fail(b, e, fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, "
-                                           "or --skip-invalid to skip such events)",
-                                           ev.x, ev.y, sensor_->width, sensor_->height));
-                ++skipped_;
-                if (!skipped_in_batch_.empty() && skipped_in_batch_.back().before == n)
-                    ++skipped_in_batch_.back().count;
-                else
-                    skipped_in_batch_.push_back({n, 1});
+                if (!options_.skip_invalid) lines_.fail(b, e, outside_sensor_message(ev.x, ev.y, sensor_));
+                skips_.skip(n);
                 continue;
             }
             last_t_ = ev.t;
@@ -197,7 +188,7 @@ std::size_t CsvReader::read(std::span<Event> out) {
         }
     } catch (const InputError&) {
         error_ = std::current_exception();
-        if (n == 0 && skipped_in_batch_.empty()) throw;
+        if (n == 0 && skips_.batch().empty()) throw;
     }
     return n;
 }

@@ -285,11 +285,11 @@ void Hdf5Reader::load_chunk() {
 }
 
 std::size_t Hdf5Reader::read(std::span<Event> out) {
-    skipped_in_batch_.clear();
+    skips_.new_batch();
     if (error_) std::rethrow_exception(error_);
     std::size_t n = 0;
     try {
-        while (n < out.size() && skipped_in_batch_.size() < out.size()) {
+        while (n < out.size() && skips_.batch().size() < out.size()) {
             if (next_ == chunk_n_) {
                 if (chunk_start_ + chunk_n_ >= total_) break;
                 load_chunk();
@@ -299,32 +299,19 @@ std::size_t Hdf5Reader::read(std::span<Event> out) {
             const auto x = static_cast<std::uint32_t>(x_[k]);  // negative: huge, outside
             const auto y = static_cast<std::uint32_t>(y_[k]);
             if (x >= limit_w_ || y >= limit_h_) [[unlikely]] {
-                if (!options_.skip_invalid) {
-                    if (sensor_)
-                        fail_at(chunk_start_ + k, 0,
-                                fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, or "
-                                            "--skip-invalid to skip such events)",
-                                            x_[k], y_[k], sensor_->width, sensor_->height));
-                    fail_at(chunk_start_ + k, 0, fmt::format("event at x={} y={} does not fit 16-bit coordinates", x_[k], y_[k]));
-                }
-                ++skipped_;
-                if (!skipped_in_batch_.empty() && skipped_in_batch_.back().before == n)
-                    ++skipped_in_batch_.back().count;
-                else
-                    skipped_in_batch_.push_back({n, 1});
+                if (!options_.skip_invalid) fail_at(chunk_start_ + k, 0, outside_sensor_message(x_[k], y_[k], sensor_));
+                skips_.skip(n);
                 continue;
             }
             if (t_[k] < last_t_) [[unlikely]]
-                fail_at(chunk_start_ + k, 2,
-                        fmt::format("timestamp goes backwards ({} us before the previous event)",
-                                    static_cast<std::uint64_t>(last_t_) - static_cast<std::uint64_t>(t_[k])));
+                fail_at(chunk_start_ + k, 2, backwards_message(last_t_, t_[k]));
             last_t_ = t_[k];
             out[n++] = Event{t_[k], static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
                              static_cast<std::uint8_t>(p_[k] > 0)};
         }
     } catch (const InputError&) {
         error_ = std::current_exception();
-        if (n == 0 && skipped_in_batch_.empty()) throw;
+        if (n == 0 && skips_.batch().empty()) throw;
     }
     return n;
 }

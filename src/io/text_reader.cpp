@@ -2,7 +2,6 @@
 
 #include <cstring>
 #include <utility>
-#include <fmt/format.h>
 
 #include "evcorner/error.hpp"
 
@@ -89,7 +88,7 @@ TextReader::TextReader(std::string path, ReaderOptions options)
     : lines_(std::move(path)), options_(options) {}
 
 std::size_t TextReader::read(std::span<Event> out) {
-    skipped_in_batch_.clear();
+    skips_.new_batch();
     if (pending_) std::rethrow_exception(std::exchange(pending_, nullptr));
     std::size_t n = 0;
     try {
@@ -101,22 +100,10 @@ std::size_t TextReader::read(std::span<Event> out) {
             if (q == e || *q == '#') continue;
             const Parsed r = parse_line(b, e);
             if (r.error != nullptr) lines_.fail(b, e, r.error);
-            if (r.e.t < last_t_)
-                lines_.fail(b, e,
-                     fmt::format("timestamp goes backwards ({} us before the previous event)",
-                                 last_t_ - r.e.t));
+            if (r.e.t < last_t_) lines_.fail(b, e, backwards_message(last_t_, r.e.t));
             if (options_.sensor && !options_.sensor->contains(r.e)) {
-                if (!options_.skip_invalid)
-                    lines_.fail(b, e,
-                         fmt::format("event at x={} y={} lies outside the {}x{} sensor "
-                                     "(set --size, or --skip-invalid to skip such events)",
-                                     r.e.x, r.e.y, options_.sensor->width,
-                                     options_.sensor->height));
-                ++skipped_;
-                if (!skipped_in_batch_.empty() && skipped_in_batch_.back().before == n)
-                    ++skipped_in_batch_.back().count;  // one run per gap: memory stays bounded
-                else
-                    skipped_in_batch_.push_back({n, 1});
+                if (!options_.skip_invalid) lines_.fail(b, e, outside_sensor_message(r.e.x, r.e.y, options_.sensor));
+                skips_.skip(n);
                 continue;
             }
             last_t_ = r.e.t;

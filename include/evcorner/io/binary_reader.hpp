@@ -20,6 +20,7 @@
 #include "evcorner/error.hpp"
 #include "evcorner/event.hpp"
 #include "evcorner/io/byte_order.hpp"
+#include "evcorner/io/event_checks.hpp"
 #include "evcorner/io/event_reader.hpp"
 #include "evcorner/io/input_file.hpp"
 #include "evcorner/sensor.hpp"
@@ -47,10 +48,8 @@ class BinaryReader : public EventReader {
 public:
     std::size_t read(std::span<Event> out) final;
 
-    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept final {
-        return skipped_in_batch_;
-    }
-    [[nodiscard]] std::uint64_t skipped() const noexcept final { return skipped_; }
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept final { return skips_.batch(); }
+    [[nodiscard]] std::uint64_t skipped() const noexcept final { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept final { return sensor_; }
     [[nodiscard]] const std::string& name() const noexcept final { return file_.name(); }
     [[nodiscard]] std::uint64_t bytes_consumed() const noexcept final { return offset(); }
@@ -158,8 +157,7 @@ private:
     std::size_t n_ = 0;
     std::int64_t last_t_ = INT64_MIN;
     std::uint64_t events_ = 0;
-    std::uint64_t skipped_ = 0;
-    std::vector<SkipRun> skipped_in_batch_;
+    SkipLog skips_;
     std::exception_ptr error_;  // sticky: thrown by every read() once set
     bool done_ = false;
 };

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "evcorner/io/event_checks.hpp"
 #include "evcorner/io/event_reader.hpp"
 #include "evcorner/io/line_source.hpp"
 
@@ -23,8 +24,8 @@ public:
     explicit CsvReader(std::string path, ReaderOptions options = {});
 
     std::size_t read(std::span<Event> out) override;
-    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skipped_in_batch_; }
-    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skipped_; }
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
+    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
     [[nodiscard]] std::string_view format() const noexcept override { return "csv"; }
     [[nodiscard]] const std::string& name() const noexcept override { return lines_.file().name(); }
@@ -45,8 +46,7 @@ private:
     bool columns_known_ = false;
     bool seen_row_ = false;  // a header row may only come first
     std::int64_t last_t_ = INT64_MIN;
-    std::uint64_t skipped_ = 0;
-    std::vector<SkipRun> skipped_in_batch_;
+    SkipLog skips_;
     std::exception_ptr error_;
 };
 

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "evcorner/io/event_checks.hpp"
 #include "evcorner/io/event_reader.hpp"
 #include "evcorner/io/event_writer.hpp"
 #include "evcorner/sensor.hpp"
@@ -50,8 +51,8 @@ public:
     Hdf5Reader& operator=(const Hdf5Reader&) = delete;
 
     std::size_t read(std::span<Event> out) override;
-    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skipped_in_batch_; }
-    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skipped_; }
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
+    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
     [[nodiscard]] std::string_view format() const noexcept override { return "hdf5"; }
     [[nodiscard]] const std::string& name() const noexcept override { return name_; }
@@ -86,8 +87,7 @@ private:
     std::size_t chunk_n_ = 0, next_ = 0;
 
     std::int64_t last_t_ = INT64_MIN;
-    std::uint64_t skipped_ = 0;
-    std::vector<SkipRun> skipped_in_batch_;
+    SkipLog skips_;
     std::exception_ptr error_;
 };
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "evcorner/event.hpp"
+#include "evcorner/io/event_checks.hpp"
 #include "evcorner/io/event_reader.hpp"
 #include "evcorner/io/line_source.hpp"
 #include "evcorner/sensor.hpp"
@@ -33,10 +34,8 @@ public:
     /// returned first; the error is thrown by the following call.
     std::size_t read(std::span<Event> out) override;
 
-    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override {
-        return skipped_in_batch_;
-    }
-    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skipped_; }
+    [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
+    [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return options_.sensor; }
     [[nodiscard]] std::string_view format() const noexcept override { return "ecd-text"; }
     [[nodiscard]] const std::string& name() const noexcept override { return lines_.file().name(); }
@@ -50,9 +49,8 @@ private:
     LineSource lines_;
     ReaderOptions options_;
     std::uint64_t events_ = 0;
-    std::uint64_t skipped_ = 0;
     std::int64_t last_t_ = INT64_MIN;
-    std::vector<SkipRun> skipped_in_batch_;
+    SkipLog skips_;
     std::exception_ptr pending_;
 };
 
