@@ -41,7 +41,7 @@ public:
     /// process() with a chosen way of finding a circle's newest pixel (arc_test.hpp).
     template <class Search>
     bool process_with(const Event& e) noexcept {
-        return View::make(sae_).template process<Search>(e);
+        return View::template make<Search>(sae_).template process<Search>(e);
     }
 
     /// detect() over a span with a chosen search. The sensor geometry and plane pointers
@@ -49,7 +49,7 @@ public:
     /// anything, so members would be reloaded (and offsets recomputed) every event.
     template <class Search>
     std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-        const View v = View::make(sae_);
+        const View v = View::template make<Search>(sae_);
         std::size_t corners = 0;
         for (std::size_t i = 0; i < events.size(); ++i) {
             const bool c = v.template process<Search>(events[i]);
@@ -69,14 +69,24 @@ private:
         std::int64_t* plane[2];
         std::ptrdiff_t width;
         int height;
-        // Circle offsets (the AVX-512 path loads the circles through them).
+        // Circle offsets: the AVX-512 path loads the circles through them (filled for it
+        // only, so that a single process() does not pay for them).
         std::int64_t off3[16];
         std::int64_t off4[20];
 
+        template <class Search>
         static View make(Sae& sae) noexcept {
-            View v{{sae.plane(0), sae.plane(1)}, sae.size().width, sae.size().height, {}, {}};
-            for (int k = 0; k < 16; ++k) v.off3[k] = kCircle3[k].dy * v.width + kCircle3[k].dx;
-            for (int k = 0; k < 20; ++k) v.off4[k] = kCircle4[k].dy * v.width + kCircle4[k].dx;
+            View v;  // the offsets stay unset (unread) on the other paths
+            v.plane[0] = sae.plane(0);
+            v.plane[1] = sae.plane(1);
+            v.width = sae.size().width;
+            v.height = sae.size().height;
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+            if constexpr (std::is_same_v<Search, Avx512Search>) {
+                for (int k = 0; k < 16; ++k) v.off3[k] = kCircle3[k].dy * v.width + kCircle3[k].dx;
+                for (int k = 0; k < 20; ++k) v.off4[k] = kCircle4[k].dy * v.width + kCircle4[k].dx;
+            }
+#endif
             return v;
         }
 
