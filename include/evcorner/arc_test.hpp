@@ -74,9 +74,6 @@ inline Newest newest_of(const std::int64_t* t) noexcept {
 }
 }  // namespace detail
 
-template <int N, int Lmin, int Lmax>
-[[nodiscard]] inline bool arc_grows_from(const std::int64_t* t, int c, std::int64_t opposite) noexcept;
-
 /// The arc test given the circle twice (t[k] == t[k + N], so that no index along an
 /// arc needs a modulo) and the index of one of its newest pixels.
 template <int N, int Lmin, int Lmax>
@@ -101,16 +98,7 @@ template <int N, int Lmin, int Lmax>
     std::int64_t opposite = t[c + Lmax];
     for (int k = c + Lmax + 1; k <= c + N - Lmax; ++k) opposite = max(opposite, t[k]);
     if (opposite >= bound) return false;
-    return arc_grows_from<N, Lmin, Lmax>(t, c, opposite);
-}
 
-/// The rest of arc_fires_from() once the cheap test has passed: `c` is a copy of the
-/// newest pixel as arc_fires_from() centres it, `opposite` the newest of t[c+Lmax ..
-/// c+N-Lmax].
-template <int N, int Lmin, int Lmax>
-[[nodiscard]] inline bool arc_grows_from(const std::int64_t* t, int c, std::int64_t opposite) noexcept {
-    using detail::max;
-    using detail::min;
     // The arc [c-a, c+b] (a, b < Lmax) leaves outside it the pixels c+b+1 .. c+N-a-1,
     // that is right[b] = newest of t[c+b+1 .. c+N-Lmax] and left[a] = newest of
     // t[c-Lmax+1 .. c-a-1]: suffix maxima, so that each length costs O(1) below.
