@@ -16,7 +16,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <deque>
+#include <span>
 #include <filesystem>
 #include <fmt/format.h>
 #include <limits>
@@ -146,14 +146,57 @@ Need need_for(const RenderOptions& o) {
     return n;
 }
 
+// Events in time order, dropped from the front: a ring that doubles when full (so at
+// most twice what it holds), made contiguous once at the end for the figure.
+class Trail {
+public:
+    void push_back(const Event& e) {
+        if (count_ == ring_.size()) grow();
+        ring_[(head_ + count_) & (ring_.size() - 1)] = e;
+        ++count_;
+    }
+    [[nodiscard]] bool empty() const noexcept { return count_ == 0; }
+    [[nodiscard]] std::size_t size() const noexcept { return count_; }
+    [[nodiscard]] const Event& front() const noexcept { return ring_[head_]; }
+    void pop_front() noexcept {
+        head_ = (head_ + 1) & (ring_.size() - 1);
+        --count_;
+    }
+    /// The events, oldest first, in one span (rotates the ring in place).
+    std::span<const Event> span() {
+        if (count_ == 0) return {};
+        std::rotate(ring_.begin(), ring_.begin() + static_cast<std::ptrdiff_t>(head_), ring_.end());
+        head_ = 0;
+        return {ring_.data(), count_};
+    }
+    void assign(std::vector<Event> v) {
+        count_ = v.size();
+        head_ = 0;
+        ring_ = std::move(v);
+        std::size_t cap = 1;
+        while (cap < ring_.size()) cap *= 2;
+        ring_.resize(cap);
+    }
+
+private:
+    void grow() {
+        std::vector<Event> bigger(std::max<std::size_t>(1024, ring_.size() * 2));
+        for (std::size_t i = 0; i < count_; ++i) bigger[i] = ring_[(head_ + i) & (ring_.size() - 1)];
+        ring_ = std::move(bigger);
+        head_ = 0;
+    }
+    std::vector<Event> ring_;  // size: a power of two (or 0)
+    std::size_t head_ = 0, count_ = 0;
+};
+
 // What streaming the input keeps.
 struct Kept {
     SensorSize size;
     std::int64_t first = 0, last = 0;  // of the events read
     std::uint64_t events_read = 0;
     std::int64_t at = 0;
-    std::deque<Event> events;
-    std::deque<Event> corners;
+    Trail events;
+    Trail corners;
     bool events_trimmed_before_at = false;  // some event <= at was dropped as too old
 };
 
@@ -231,9 +274,9 @@ Kept stream_input(const RenderOptions& o, const Need& need, bool detect_here) {
 }
 
 // Corner events from a file, streamed: those of [lo, hi].
-std::deque<Event> stream_corners_file(const RenderOptions& o, std::int64_t lo, std::int64_t hi) {
+std::vector<Event> stream_corners_file(const RenderOptions& o, std::int64_t lo, std::int64_t hi) {
     const auto reader = io::open_event_reader(o.corners_file, reader_options(o.in), o.in.format);
-    std::deque<Event> out;
+    std::vector<Event> out;
     std::vector<Event> batch(kBatch);
     for (;;) {
         const std::size_t n = reader->read(batch);
@@ -274,11 +317,12 @@ void run_render(RenderOptions& o) {
     std::int64_t window = need.events_before;
     if (need.auto_window) {
         std::size_t before = 0;  // kept events at or before --at
-        for (const Event& e : k.events) before += e.t <= at;
+        const std::span<const Event> kept = k.events.span();
+        for (const Event& e : kept) before += e.t <= at;
         std::int64_t span = 0;
         if (before >= kAutoEvents) {
             std::size_t i = 0;
-            for (const Event& e : k.events)
+            for (const Event& e : kept)
                 if (e.t <= at && ++i == before - kAutoEvents + 1) {
                     span = at - e.t;
                     break;
@@ -294,10 +338,9 @@ void run_render(RenderOptions& o) {
                                     ? kNoBound
                                     : at - (need.auto_window ? window + (need.corners_before - kAutoMaxUs)
                                                              : need.corners_before);
-        k.corners = stream_corners_file(o, lo, at + need.corners_after);
+        k.corners.assign(stream_corners_file(o, lo, at + need.corners_after));
     }
-    const std::vector<Event> events(k.events.begin(), k.events.end());
-    const std::vector<Event> corners(k.corners.begin(), k.corners.end());
+    const std::span<const Event> events = k.events.span(), corners = k.corners.span();
     const std::string file = shown_name(o.input);
     const std::string det = detector_text(o);
 

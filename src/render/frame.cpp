@@ -197,7 +197,7 @@ Framed frame_space_time_figure(const RgbImage& body, SensorSize size, std::int64
     const TimeAxis unit = time_unit_for(t1 - t0);
     const double span = static_cast<double>(t1 - t0) / unit.divisor;
     const double time_px = kx * style.time_height;
-    const auto tt = nice_ticks(0, span, std::max(1e-9, span * (k.line + 8.0 * k.ts) / time_px));
+    const auto tt = nice_ticks(0, span, std::max(1e-9, span * (k.line + 20.0 * k.ts) / time_px));
     const double tstep = tt.size() > 1 ? tt[1] - tt[0] : std::max(span, 1e-9);
     int tlab = 0;
     for (const double v : tt) tlab = std::max(tlab, text_width(tick_label(v, tstep), k.ts));
@@ -211,8 +211,9 @@ Framed frame_space_time_figure(const RgbImage& body, SensorSize size, std::int64
     for (const double v : yt) ylab = std::max(ylab, text_width(tick_label(v, 1), k.ts));
     const std::string xcap = "x [px]", ycap = "y [px]";
 
-    const int left = k.pad + std::max(tlab + 6 * k.ts, text_width(tcap, k.ts) - lay.margin);
-    const int top = title_height(f, k) + k.line;  // the time caption's row
+    // The time caption stands left of the time axis's top end, the labels left of its ticks.
+    const int left = k.pad + std::max(tlab + 6 * k.ts, text_width(tcap, k.ts) + 2 * k.ts) + k.tick - lay.margin;
+    const int top = title_height(f, k);
     const int gap = 6 * k.ts;  // between a tick and its label, so that the tick reads as no minus sign
     ylab = std::max(ylab, text_width(ycap, k.ts));
     int width = left + body.width() + std::max(k.pad, ylab + k.tick + gap + k.pad - lay.margin);
@@ -263,7 +264,7 @@ Framed frame_space_time_figure(const RgbImage& body, SensorSize size, std::int64
     {
         int u, w;
         at(0, h1, 1, u, w);
-        draw_text(img, std::max(k.pad, u - text_width(tcap, k.ts) / 2), top - k.line, tcap, kFrameInk, k.ts);
+        draw_text(img, u - 2 * k.ts - text_width(tcap, k.ts), w - k.line - 4 * k.ts, tcap, kFrameInk, k.ts);
     }
     for (const double v : yt) {
         int u, w;
