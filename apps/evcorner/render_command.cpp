@@ -42,8 +42,8 @@ namespace {
 constexpr std::size_t kBatch = 1 << 16;
 // The default space-time window: the time the last kAutoEvents events before --at span,
 // rounded down to two significant digits, at most kAutoMaxUs. About 20 000 events trace the
-// moving edges as tubes and sheets on the box; the whole 52 s recording (23 M events) or even
-// one second of it merges into a grey block, and a few thousand leave scattered dots. The
+// moving edges as tubes and sheets on the box; a whole 52 s recording or even one second of
+// it merges into a grey block, and a few thousand leave scattered dots. The
 // window follows the event rate: the 650 k events/s sample gets 30 ms, a sparse recording at
 // most half a second. Bounded by a count, it also bounds what streaming keeps.
 constexpr std::size_t kAutoEvents = 20'000;
