@@ -215,7 +215,7 @@ Kept stream_input(const RenderOptions& o, const Need& need, bool detect_here) {
     Progress progress(!o.no_progress, reader->bytes_total());
     std::vector<Event> batch(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
-    bool stop = false;
+    bool stop = false, before_start = false;
     while (!stop) {
         const std::size_t n = reader->read(batch);
         if (n == 0) {
@@ -227,10 +227,16 @@ Kept stream_input(const RenderOptions& o, const Need& need, bool detect_here) {
             k.first = b.front().t;
             if (!at_from_end) {
                 at = parse_time_option(o.at, k.first, k.first);
-                if (*at < k.first)
-                    throw std::invalid_argument(fmt::format("--at {}: {} is before the stream's first event at {}", o.at,
-                                                            seconds(*at), seconds(k.first)));
+                // Before the stream: the error names the stream's range, so read on to its end.
+                before_start = *at < k.first;
+                if (before_start) detector.reset();
             }
+        }
+        if (before_start) {
+            k.events_read += n;
+            k.last = b.back().t;
+            progress.update(reader->bytes_consumed(), k.events_read);
+            continue;
         }
         if (detector) std::visit([&](auto& d) { detect(d, b, flags); }, *detector);
         for (std::size_t i = 0; i < n; ++i) {
@@ -460,7 +466,7 @@ void add_render_command(CLI::App& app) {
                 if (std::isfinite(v) && v > 0) return std::string();
             } catch (const std::exception&) {
             }
-            return "--window must be a number of milliseconds > 0, not '" + s + "'";
+            return "must be a number of milliseconds > 0, not '" + s + "'";
         });
     cmd->add_option("--scale", o->scale, "Image pixels per sensor pixel")->capture_default_str()->check(CLI::Range(1, 16));
     cmd->add_option("--polarity", o->polarity, "sae: polarity shown, 1 = ON, 0 = OFF")
