@@ -148,7 +148,7 @@ Framed frame_sensor_figure(const RgbImage& body, SensorSize size, int scale, con
     for (const double v : yt) ylab = std::max(ylab, text_width(tick_label(v, 1), k.ts));
     const std::string ycap = "y [px]", xcap = "x [px]";
     const int left = k.pad + std::max(ylab + 3 * k.ts + k.tick, text_width(ycap, k.ts)) + 1;
-    const int top = title_height(f, k) + k.line;  // the y caption's row above the box
+    const int top = title_height(f, k) + k.line + text_height(k.ts) / 2;  // the y caption's row above the box
     const int last_label = text_width(tick_label(xt.back(), 1), k.ts);
     int width = left + body.width() + 1 + std::max(k.pad, last_label / 2 + k.pad / 2);
     width = std::max(width, widest(f.title, k.ts) + 2 * k.pad);
