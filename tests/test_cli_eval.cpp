@@ -96,9 +96,9 @@ TEST_F(CliEval, RenderEveryKindAsPng) {
         const auto [w, h] = png_size(dir_ / (kind + ".png"));
         EXPECT_GT(w, 0u) << kind;
         EXPECT_GT(h, 0u) << kind;
-        if (kind == "sae" || kind == "corners") {  // the sensor at the default scale of 2
-            EXPECT_EQ(w, 480u) << kind;
-            EXPECT_EQ(h, 360u) << kind;
+        if (kind == "sae" || kind == "corners") {  // the sensor at the default scale of 2, framed
+            EXPECT_GT(w, 480u) << kind;
+            EXPECT_GT(h, 360u) << kind;
         }
     }
     std::string err;

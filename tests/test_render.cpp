@@ -7,6 +7,8 @@
 
 #include "evcorner/error.hpp"
 #include "evcorner/render/figures.hpp"
+#include "evcorner/render/font.hpp"
+#include "evcorner/render/frame.hpp"
 #include "evcorner/render/image.hpp"
 
 namespace evcorner::render {
@@ -96,6 +98,83 @@ TEST(Render, PngRoundTripAndErrors) {
     EXPECT_THROW(write_png("/no/such/dir/x.png", img), OutputError);
     EXPECT_THROW(read_png("/no/such/file.png"), InputError);
     EXPECT_THROW(RgbImage(0, 3), std::invalid_argument);
+}
+
+
+TEST(Font, EveryPrintableCharacterHasItsOwnGlyphInsideItsBox) {
+    std::set<std::string> seen;
+    for (int c = 32; c <= 126; ++c) {
+        const std::string s(1, static_cast<char>(c));
+        RgbImage img(20, 20, {255, 255, 255});
+        draw_text(img, 5, 6, s, {0, 0, 0}, 2);
+        int ink = 0;
+        for (int y = 0; y < 20; ++y)
+            for (int x = 0; x < 20; ++x) {
+                if (img.at(x, y) != Rgb{0, 0, 0}) continue;
+                ++ink;
+                EXPECT_TRUE(x >= 5 && x < 5 + text_width(s, 2) && y >= 6 && y < 6 + text_height(2)) << s;
+            }
+        EXPECT_EQ(ink > 0, c != ' ') << "'" << s << "'";
+        EXPECT_TRUE(seen.insert(std::string(img.bytes().begin(), img.bytes().end())).second) << "'" << s << "' looks like another character";
+    }
+    EXPECT_EQ(text_width("", 1), 0);
+    EXPECT_EQ(text_width("ab", 1), 11);
+    RgbImage img(10, 10, {255, 255, 255});
+    draw_text(img, 0, 0, "\x01", {0, 0, 0});  // outside printable ASCII: a box, not nothing
+    draw_text(img, -50, -50, "clipped", {0, 0, 0}, 3);
+    EXPECT_EQ(img.at(0, 0), (Rgb{0, 0, 0}));
+}
+
+TEST(Frame, NiceTicksAndLabels) {
+    EXPECT_EQ(nice_ticks(0, 239, 40), (std::vector<double>{0, 50, 100, 150, 200}));
+    EXPECT_EQ(nice_ticks(0, 179, 21), (std::vector<double>{0, 50, 100, 150}));
+    EXPECT_EQ(nice_ticks(0, 10, 1.5), (std::vector<double>{0, 2, 4, 6, 8, 10}));
+    const auto t = nice_ticks(0, 1, 0.3);
+    ASSERT_EQ(t.size(), 3u);
+    EXPECT_EQ(tick_label(t[1], 0.5), "0.5");
+    EXPECT_EQ(tick_label(120, 20), "120");
+    EXPECT_EQ(tick_label(-0.0001, 0.1), "0.0");
+    EXPECT_THROW(nice_ticks(1, 0, 1), std::invalid_argument);
+    EXPECT_THROW(nice_ticks(0, 1, 0), std::invalid_argument);
+}
+
+TEST(Frame, SensorFigureKeepsTheBodyAndDrawsAxesTitleLegend) {
+    RgbImage body(80, 60, {0, 0, 0});
+    body.set(3, 4, {1, 2, 3});
+    FigureFrame f;
+    f.title = {"a title"};
+    f.legend = {{kOnBright, "ON corner"}};
+    const Framed out = frame_sensor_figure(body, kSize, 2, f);
+    for (int y = 0; y < body.height(); ++y)
+        for (int x = 0; x < body.width(); ++x) ASSERT_EQ(out.image.at(out.body_x + x, out.body_y + y), body.at(x, y));
+    EXPECT_EQ(out.image.at(out.body_x - 1, out.body_y + 10), kAxisInk);
+    EXPECT_EQ(out.image.at(out.body_x + 10, out.body_y + body.height()), kAxisInk);
+    int title_ink = 0, swatch = 0;
+    for (int y = 0; y < out.body_y; ++y)
+        for (int x = 0; x < out.image.width(); ++x) title_ink += out.image.at(x, y) == kFrameInk;
+    for (int y = out.body_y + body.height(); y < out.image.height(); ++y)
+        for (int x = 0; x < out.image.width(); ++x) swatch += out.image.at(x, y) == kOnBright;
+    EXPECT_GT(title_ink, 20);
+    EXPECT_EQ(swatch, kGlyphHeight * kGlyphHeight);
+    EXPECT_THROW(frame_sensor_figure(body, kSize, 1, f), std::invalid_argument);
+}
+
+TEST(Frame, SpaceTimeFrameDrawsOverTheLayoutsEdges) {
+    SpaceTimeStyle style;
+    style.scale = 1;
+    style.time_height = 100;
+    const RgbImage body = render_space_time({}, {}, {}, kSize, 0, 10'000, style);
+    FigureFrame f;
+    f.title = {"space-time"};
+    const Framed out = frame_space_time_figure(body, kSize, 0, 10'000, style, f);
+    const SpaceTimeLayout lay = space_time_layout(kSize, style);
+    int u = 0, v = 0;
+    lay.project(0, kSize.height - 1, 0.5, u, v);  // on the time axis
+    EXPECT_EQ(out.image.at(out.body_x + u, out.body_y + v), kAxisInk);
+    lay.project(kSize.width / 2.0, kSize.height - 1, 0, u, v);  // on the x axis
+    EXPECT_EQ(out.image.at(out.body_x + u, out.body_y + v), kAxisInk);
+    EXPECT_THROW(frame_space_time_figure(body, kSize, 5, 5, style, f), std::invalid_argument);
+    EXPECT_THROW(frame_space_time_figure(RgbImage(3, 3), kSize, 0, 10, style, f), std::invalid_argument);
 }
 
 }  // namespace

@@ -52,25 +52,35 @@ RgbImage render_recent_corners(std::span<const Event> events, std::span<const Ev
     return img;
 }
 
+void SpaceTimeLayout::project(double x, double y, double tau, int& u, int& v) const noexcept {
+    const double k = style.scale;
+    u = margin + static_cast<int>(std::lround(k * (x + style.depth * (size.height - 1 - y))));
+    v = margin + static_cast<int>(std::lround(k * (style.time_height * (1.0 - tau) + style.depth * y)));
+}
+
+SpaceTimeLayout space_time_layout(SensorSize size, const SpaceTimeStyle& s) {
+    if (s.scale < 1 || s.time_height < 1) throw std::invalid_argument("space-time figure: bad style");
+    SpaceTimeLayout l;
+    l.size = size;
+    l.style = s;
+    const double k = s.scale;
+    const double depth_px = s.depth * size.height;
+    l.margin = 4 * s.scale;
+    l.width = static_cast<int>(std::ceil(k * (size.width + depth_px))) + 2 * l.margin;
+    l.height = static_cast<int>(std::ceil(k * (s.time_height + depth_px))) + 2 * l.margin;
+    return l;
+}
+
 RgbImage render_space_time(std::span<const Event> events, std::span<const Event> corners,
                            std::span<const std::uint8_t> labels, SensorSize size, std::int64_t t0,
                            std::int64_t t1, const SpaceTimeStyle& s) {
     if (t1 <= t0) throw std::invalid_argument("space-time figure: empty interval");
     if (!labels.empty() && labels.size() != corners.size())
         throw std::invalid_argument("space-time figure: one label per corner event needed");
-    if (s.scale < 1 || s.time_height < 1) throw std::invalid_argument("space-time figure: bad style");
-    const double k = s.scale;
-    const double depth_px = s.depth * size.height;
-    const int margin = 4 * s.scale;
-    const int w = static_cast<int>(std::ceil(k * (size.width + depth_px))) + 2 * margin;
-    const int h = static_cast<int>(std::ceil(k * (s.time_height + depth_px))) + 2 * margin;
-    RgbImage img(w, h, {255, 255, 255});
+    const SpaceTimeLayout layout = space_time_layout(size, s);
+    RgbImage img(layout.width, layout.height, {255, 255, 255});
     const double span = static_cast<double>(t1 - t0);
-    // Oblique projection: x to the right, y into the page (up and to the right), time up.
-    auto project = [&](double x, double y, double tau, int& u, int& v) {
-        u = margin + static_cast<int>(std::lround(k * (x + s.depth * (size.height - 1 - y))));
-        v = margin + static_cast<int>(std::lround(k * (s.time_height * (1.0 - tau) + s.depth * y)));
-    };
+    auto project = [&](double x, double y, double tau, int& u, int& v) { layout.project(x, y, tau, u, v); };
     const Rgb frame{170, 170, 170};
     const double xs[4] = {0, static_cast<double>(size.width - 1), static_cast<double>(size.width - 1), 0};
     const double ys[4] = {0, 0, static_cast<double>(size.height - 1), static_cast<double>(size.height - 1)};

@@ -39,6 +39,11 @@ void RgbImage::line(int x0, int y0, int x1, int y1, Rgb c) noexcept {
     }
 }
 
+void RgbImage::paste(const RgbImage& src, int x, int y) noexcept {
+    for (int sy = 0; sy < src.height(); ++sy)
+        for (int sx = 0; sx < src.width(); ++sx) set(x + sx, y + sy, src.at(sx, sy));
+}
+
 RgbImage upscale(const RgbImage& in, int factor) {
     if (factor < 1) throw std::invalid_argument("upscale factor must be >= 1");
     if (factor == 1) return in;

@@ -47,6 +47,20 @@ struct SpaceTimeStyle {
     int corner_side = 2;      ///< image pixels per corner dot, before scale
 };
 
+/// The oblique projection of render_space_time: x to the right, y into the page (up and
+/// to the right by `depth` per pixel), time upwards.
+struct SpaceTimeLayout {
+    SensorSize size;
+    SpaceTimeStyle style;
+    int margin = 0;             ///< blank image pixels around the box
+    int width = 0, height = 0;  ///< the image's size
+
+    /// Image position of sensor point (x, y) at relative time tau (0 = t0, 1 = t1).
+    void project(double x, double y, double tau, int& u, int& v) const noexcept;
+};
+/// Throws std::invalid_argument for a scale or time height < 1.
+SpaceTimeLayout space_time_layout(SensorSize size, const SpaceTimeStyle& style);
+
 /// Fig. 1b (labels empty: corners green ON / red OFF) and Fig. 5b (labels given, one per
 /// corner: green on a track, red off it). Events and corners outside [t0, t1] are left out.
 /// White background; sensor box edges at t0 and t1 in grey.

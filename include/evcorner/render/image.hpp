@@ -41,6 +41,13 @@ public:
         for (int dy = 0; dy < side; ++dy)
             for (int dx = 0; dx < side; ++dx) set(x + dx, y + dy, c);
     }
+    /// A filled rectangle with its top-left at (x, y), clipped.
+    void fill_rect(int x, int y, int w, int h, Rgb c) noexcept {
+        for (int dy = 0; dy < h; ++dy)
+            for (int dx = 0; dx < w; ++dx) set(x + dx, y + dy, c);
+    }
+    /// Copies `src` with its top-left at (x, y), clipped.
+    void paste(const RgbImage& src, int x, int y) noexcept;
     /// A straight line, clipped (Bresenham).
     void line(int x0, int y0, int x1, int y1, Rgb c) noexcept;
 
