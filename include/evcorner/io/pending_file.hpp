@@ -18,6 +18,10 @@
 //   permission) is written in place, as before: the one case that is not atomic.
 // - SIGKILL and power loss cannot be caught: they may leave a temporary file behind,
 //   never a partial file under the name.
+// - The handler removes a relative temporary name relative to the working directory of
+//   the moment: a program that changes directory while writing should give absolute paths.
+// - Replacing a file by renaming gives it a new inode: other hard links to the old file
+//   keep the old content (as with editors that save this way).
 
 #include <string>
 
