@@ -227,7 +227,9 @@ TEST_F(CliOutputs, EveryFailedWriteIsAnError) {
           "$E detect " + sample() + " -q > " + full, "$E detect " + sample() + " -q -o " + full,
           "$E detect " + sample() + " -q -o c.txt --mask " + full,
           "$E detect " + sample() + " -q -o c.txt --summary-json - > " + full,
-          "$E convert " + sample() + " - -q > " + full, "$E info " + sample() + " --json " + full}) {
+          "$E convert " + sample() + " - -q > " + full, "$E info " + sample() + " --json " + full,
+          // label and eval print their results through the same checked standard output
+          "$E detect " + sample() + " -q -o c.txt && $E label c.txt > " + full, "$E eval " + sample() + " -q > " + full}) {
         SCOPED_TRACE(cmd);
         const Result r = sh(cmd);
         EXPECT_EQ(r.status, 1) << r.err;
