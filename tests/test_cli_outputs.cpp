@@ -340,6 +340,8 @@ TEST_F(CliOutputs, UnknownFormatNamesAndCommandsAreUsageErrors) {
     EXPECT_NE(r.err.find("unknown command 'detec'; did you mean 'detect'?"), std::string::npos) << r.err;
     r = run("conver x y");
     EXPECT_NE(r.err.find("did you mean 'convert'?"), std::string::npos) << r.err;
+    r = run("INFO x");
+    EXPECT_NE(r.err.find("unknown command 'INFO'; did you mean 'info'?"), std::string::npos) << r.err;
     r = run("frobnicate");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("unknown command 'frobnicate' (commands: detect, info, convert"), std::string::npos)

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <exception>
@@ -46,7 +47,9 @@ std::string unknown_command(CLI::App& app, const std::string& word) {
     std::string best;
     std::size_t best_d = std::string::npos;
     for (const auto& n : names) {
-        const std::size_t d = edit_distance(word, n);
+        std::string lower = word;  // "DETECT" is a slip too
+        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        const std::size_t d = lower == n ? 1 : edit_distance(lower, n);
         if (d < best_d) {
             best_d = d;
             best = n;
