@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <fmt/format.h>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -39,7 +40,10 @@
 #include "evcorner/any_detector.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/io/output_file.hpp"
+#include "evcorner/io/output_paths.hpp"
 #include "evcorner/parallel_detect.hpp"
+#include "progress.hpp"
+#include "std_streams.hpp"
 
 #ifndef EVCORNER_BUILD_TYPE
 #define EVCORNER_BUILD_TYPE "unknown"
@@ -64,6 +68,7 @@ struct BenchOptions {
     std::string threads = "1";
     bool no_latency = false;
     bool quiet = false;
+    bool no_progress = false;
 };
 
 struct Row {
@@ -220,9 +225,13 @@ Latency time_each_event(D& det, const std::vector<Event>& events) {
 // A row of `repeat` throughput passes over `events`. pass(row, flags) builds a fresh
 // detector, runs it over the stream inside `time(...)`, and sets the row's corners and
 // memory; the row gets ns/event per pass and their median, min and max.
+// Called after each pass over a stream (outside the timing) with the events it ran over.
+using PassDone = std::function<void(std::uint64_t events)>;
+
 template <class Pass>
 Row timed_passes(const std::string& input, const std::string& name, int threads, SensorSize sensor,
-                 const std::vector<Event>& events, std::uint64_t file_events, int repeat, Pass pass) {
+                 const std::vector<Event>& events, std::uint64_t file_events, int repeat, Pass pass,
+                 const PassDone& done) {
     Row row;
     row.input = input;
     row.detector = name;
@@ -238,6 +247,7 @@ Row timed_passes(const std::string& input, const std::string& name, int threads,
             run();
             row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / n);
         });
+        done(events.size());
     }
     row.median = median_of(row.ns_per_event);
     row.min = *std::min_element(row.ns_per_event.begin(), row.ns_per_event.end());
@@ -247,7 +257,7 @@ Row timed_passes(const std::string& input, const std::string& name, int threads,
 
 Row bench_one(const std::string& input, const std::string& name, SensorSize sensor,
               const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
-              Latency& clock) {
+              Latency& clock, const PassDone& done) {
     Row row = timed_passes(input, name, 1, sensor, events, file_events, o.repeat,
                            [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
                                AnyDetector any = make_detector(name, sensor);
@@ -257,7 +267,8 @@ Row bench_one(const std::string& input, const std::string& name, SensorSize sens
                                        time([&] { r.corners = detect(det, std::span<const Event>(events), flags); });
                                    },
                                    any);
-                           });
+                           },
+                           done);
     if (!o.no_latency) {
         AnyDetector any = make_detector(name, sensor);
         std::visit(
@@ -269,20 +280,23 @@ Row bench_one(const std::string& input, const std::string& name, SensorSize sens
                 clock = l;
             },
             any);
+        done(events.size());
     }
     return row;
 }
 
 /// Throughput passes with the sensor split over `threads` threads (parallel_detect.hpp).
 Row bench_parallel(const std::string& input, const std::string& name, int threads, SensorSize sensor,
-                   const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o) {
+                   const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
+                   const PassDone& done) {
     auto passes = [&](auto make_par) {
         return timed_passes(input, name, threads, sensor, events, file_events, o.repeat,
                             [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
                                 auto par = make_par();  // threads started outside the timing
                                 time([&] { r.corners = par->detect(std::span<const Event>(events), flags); });
                                 r.memory = par->memory_bytes([](const auto& d) { return d.memory_bytes(); });
-                            });
+                            },
+                            done);
     };
     if (name == "efast")
         return passes([&] {
@@ -309,31 +323,31 @@ std::string short_name(const std::string& path) {
     return s;
 }
 
-void print_table(const std::vector<Row>& rows, const std::vector<std::string>& detectors,
+void print_table(std::FILE* out, const std::vector<Row>& rows, const std::vector<std::string>& detectors,
                  const std::vector<int>& thread_counts, bool latency) {
-    fmt::print("{:<34} {:<13} {:>3} {:>10} {:>7} {:>7} {:>7} {:>8}", "input", "detector", "thr", "events", "median",
+    fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>7} {:>7} {:>7} {:>8}", "input", "detector", "thr", "events", "median",
                "min", "max", "Mev/s");
-    if (latency) fmt::print(" {:>7} {:>7} {:>7}", "p50", "p99", "p99.9");
-    fmt::print(" {:>11}\n", "memory [B]");
-    fmt::print("{:<34} {:<13} {:>3} {:>10} {:>23} {:>8}", "", "", "", "", "ns/event", "max rate");
-    if (latency) fmt::print(" {:>23}", "latency ns/event");
-    fmt::print("\n");
+    if (latency) fmt::print(out, " {:>7} {:>7} {:>7}", "p50", "p99", "p99.9");
+    fmt::print(out, " {:>11}\n", "memory [B]");
+    fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>23} {:>8}", "", "", "", "", "ns/event", "max rate");
+    if (latency) fmt::print(out, " {:>23}", "latency ns/event");
+    fmt::print(out, "\n");
     auto line = [&](const std::string& in, const std::string& det, int thr, std::uint64_t ev, double med, double mn,
                     double mx, double p50, double p99, double p999, std::size_t mem) {
-        fmt::print("{:<34} {:<13} {:>3} {:>10} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.2f}", in, det, thr, ev, med, mn, mx,
-                   med > 0 ? 1e3 / med : 0.0);
+        fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.2f}", in, det, thr, ev, med, mn,
+                   mx, med > 0 ? 1e3 / med : 0.0);
         if (latency && p50 > 0)
-            fmt::print(" {:>7.0f} {:>7.0f} {:>7.0f}", p50, p99, p999);
+            fmt::print(out, " {:>7.0f} {:>7.0f} {:>7.0f}", p50, p99, p999);
         else if (latency)
-            fmt::print(" {:>7} {:>7} {:>7}", "-", "-", "-");
-        fmt::print(" {:>11}\n", mem);
+            fmt::print(out, " {:>7} {:>7} {:>7}", "-", "-", "-");
+        fmt::print(out, " {:>11}\n", mem);
     };
     for (const Row& r : rows)
         line(short_name(r.input), r.detector, r.threads, r.events, r.median, r.min, r.max, r.p50, r.p99, r.p999, r.memory);
     std::size_t files = 0;
     for (const Row& r : rows) files += r.detector == detectors.front() && r.threads == thread_counts.front();
     if (files < 2) return;
-    fmt::print("\nmedian over the {} inputs of the per-input figures (min: smallest min, max: largest max):\n",
+    fmt::print(out, "\nmedian over the {} inputs of the per-input figures (min: smallest min, max: largest max):\n",
                files);
     for (const std::string& d : detectors)
     for (const int thr : thread_counts) {
@@ -409,6 +423,13 @@ std::vector<std::string> split_list(const std::string& s) {
 }
 
 void run_bench(const BenchOptions& o) {
+    {
+        std::vector<io::NamedPath> inputs;
+        for (const auto& in : o.inputs) inputs.push_back({"FILE", in});
+        if (!o.json.empty()) io::check_output_paths(inputs, {{"--json", o.json}});
+    }
+    // With the JSON on standard output, the human-readable report goes to standard error.
+    std::FILE* const out = o.json == "-" ? stderr : stdout;
     const std::vector<std::string> detectors = split_list(o.detectors);
     if (detectors.empty()) throw std::invalid_argument("-d: no detector named");
     for (const auto& d : detectors) (void)make_detector(d, kDavis240);  // unknown names fail now
@@ -421,16 +442,31 @@ void run_bench(const BenchOptions& o) {
     if (thread_counts.empty()) thread_counts.push_back(1);
 
     const std::string cpu = cpu_model();
-    fmt::print("evcorner bench: {} input(s), detectors {}, {} pass(es) each over >= {} events\n", o.inputs.size(),
-               o.detectors, o.repeat, o.min_events);
-    fmt::print("CPU      {}\n", cpu);
-    fmt::print("build    {} build, {}, flags: {}; eFAST code path: {}\n", EVCORNER_BUILD_TYPE, compiler(),
+    fmt::print(out, "evcorner bench: {} input(s), detectors {}, {} pass(es) each over >= {} events\n",
+               o.inputs.size(), o.detectors, o.repeat, o.min_events);
+    fmt::print(out, "CPU      {}\n", cpu);
+    fmt::print(out, "build    {} build, {}, flags: {}; eFAST code path: {}\n", EVCORNER_BUILD_TYPE, compiler(),
                EVCORNER_BUILD_FLAGS, efast_code_path());
-    fmt::print("method   one thread; throughput: steady_clock around detect() over the replayed stream,\n"
+    fmt::print(out, "method   one thread; throughput: steady_clock around detect() over the replayed stream,\n"
                "         fresh detector per pass; latency: rdtscp/lfence around each event, clock overhead\n"
                "         subtracted (fenced, so an upper bound)\n\n");
-    std::fflush(stdout);
+    flush_checked(out);
 
+    // The progress bar counts passes: per input, each detector and thread count runs
+    // --repeat passes, plus one latency pass on one thread.
+    std::uint64_t runs_per_input = 0;
+    for (const std::string& d : detectors)
+        for (const int thr : thread_counts) {
+            if (thr > 1 && d != "efast" && d != "harris") continue;
+            runs_per_input += static_cast<std::uint64_t>(o.repeat) + (thr == 1 && !o.no_latency ? 1 : 0);
+        }
+    Progress progress(!o.quiet && !o.no_progress, runs_per_input * o.inputs.size());
+    std::uint64_t passes_done = 0, events_done = 0;
+    const PassDone done = [&](std::uint64_t events) {
+        ++passes_done;
+        events_done += events;
+        progress.update(passes_done, events_done);
+    };
     std::vector<Row> rows;
     Latency clock;
     for (const std::string& input : o.inputs) {
@@ -444,24 +480,29 @@ void run_bench(const BenchOptions& o) {
             stream = replay(file.events, o.min_events);
         }
         if (stream.empty()) {
+            progress.finish();
             fmt::print(stderr, "evcorner bench: {}: no events, skipped\n", input);
+            passes_done += runs_per_input;
             continue;
         }
         for (const std::string& d : detectors)
             for (const int thr : thread_counts) {
                 if (thr > 1 && d != "efast" && d != "harris") continue;  // not local: one thread only
-                rows.push_back(thr == 1 ? bench_one(input, d, sensor, stream, file_events, o, clock)
-                                        : bench_parallel(input, d, thr, sensor, stream, file_events, o));
-                std::fflush(stdout);
+                rows.push_back(thr == 1 ? bench_one(input, d, sensor, stream, file_events, o, clock, done)
+                                        : bench_parallel(input, d, thr, sensor, stream, file_events, o, done));
+                progress.finish();
+                flush_checked(out);
                 if (!o.quiet)
                     fmt::print(stderr, "  {} {} x{}: {:.1f} ns/event\n", short_name(input), d, thr, rows.back().median);
             }
     }
+    progress.finish();
     if (!o.quiet) fmt::print(stderr, "\n");
-    print_table(rows, detectors, thread_counts, !o.no_latency);
+    print_table(out, rows, detectors, thread_counts, !o.no_latency);
     if (!o.no_latency)
-        fmt::print("\nlatency clock: overhead {:.1f} ns (subtracted), resolution {:.1f} ns\n", clock.overhead_ns,
+        fmt::print(out, "\nlatency clock: overhead {:.1f} ns (subtracted), resolution {:.1f} ns\n", clock.overhead_ns,
                    clock.resolution_ns);
+    flush_checked(out);
     if (!o.json.empty()) write_json(o.json, rows, cpu, clock, o);
 }
 
@@ -484,14 +525,17 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--min-events", o->min_events, "Replay each input until it holds at least this many events")
         ->capture_default_str()
         ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
-    cmd->add_option("--json", o->json, "Also write every figure as JSON to this file (- = standard output)");
+    cmd->add_option("--json", o->json,
+                    "Also write every figure as JSON to this file (- = standard output; the report then goes "
+                    "to standard error)");
     add_load_options(*cmd, o->in);
     cmd->add_option("--threads", o->threads,
                     "Comma-separated thread counts, e.g. 1,2: efast and harris also run split over that many "
                     "threads (parallel_detect.hpp; no latency pass); others run on one")
         ->capture_default_str();
     cmd->add_flag("--no-latency", o->no_latency, "Skip the per-event latency pass");
-    cmd->add_flag("-q,--quiet", o->quiet, "No per-run progress lines on standard error");
+    cmd->add_flag("-q,--quiet", o->quiet, "No per-run progress lines and no progress bar on standard error");
+    cmd->add_flag("--no-progress", o->no_progress, "No progress bar (it shows only on a terminal)");
     cmd->footer(
         "Examples:\n"
         "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt\n"

@@ -16,5 +16,7 @@ void add_bench_command(CLI::App& app);
 
 /// The input-format options that info and convert share (--format, --csv-columns, --time-unit).
 void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit);
+/// --to: the output format (detect, convert); an unknown name is a usage error.
+void add_output_format_option(CLI::App& cmd, std::string& to);
 
 }  // namespace evcorner::cli

@@ -3,9 +3,11 @@
 // Streams batch by batch in constant memory. On bad input the events before the error
 // are written (a complete, valid output file) and the error is reported.
 
+#include <algorithm>
 #include <cstdio>
 #include <fmt/format.h>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,8 @@
 #include "evcorner/error.hpp"
 #include "evcorner/io/event_writer.hpp"
 #include "evcorner/io/open.hpp"
+#include "evcorner/io/output_paths.hpp"
+#include "progress.hpp"
 
 namespace evcorner::cli {
 
@@ -30,9 +34,27 @@ struct ConvertOptions {
     bool skip_invalid = false;
     bool allow_damaged = false;
     bool quiet = false;
+    bool no_progress = false;
 };
 
+// The size recorded for an input that gives none (no --size): the DAVIS240C's, which
+// detect would use, when every event fits in it; else the events' bounding box, with a
+// warning (only formats with a field for it record either).
+SensorSize fallback_size(int max_x, int max_y, const std::string& to, const std::string& output) {
+    if (max_x < kDavis240.width && max_y < kDavis240.height) return kDavis240;
+    const SensorSize box{max_x + 1, max_y + 1};
+    if (to == "aedat4" || to == "hdf5")
+        fmt::print(stderr,
+                   "evcorner: warning: the input does not give its sensor size and its events do not fit the "
+                   "{}x{} default; {} records their bounding box {}x{} (pass --size WxH to record the sensor's)\n",
+                   kDavis240.width, kDavis240.height, output, box.width, box.height);
+    return box;
+}
+
 void run_convert(const ConvertOptions& o) {
+    // Before anything is opened: an output onto the input, and the output format.
+    io::check_output_paths({{"INPUT", o.input}}, {{"OUTPUT", o.output}});
+    const std::string to = io::resolve_output_format(o.output, o.to);
     io::ReaderOptions ropts;
     ropts.skip_invalid = o.skip_invalid;
     ropts.fallback_sensor = std::nullopt;  // converting needs no sensor; --size checks one
@@ -40,32 +62,42 @@ void run_convert(const ConvertOptions& o) {
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
-    std::string to = o.to;
-    if (to == "auto") {
-        to = io::output_format_for(o.output);
-        if (to.empty())
-            throw OutputError(o.output, "cannot tell the output format from the extension; pass --to (" +
-                                            std::string(io::kOutputFormats) + ")");
-    }
-    const auto writer = io::open_event_writer(o.output, to, reader->sensor());
+    // The input's size (--size included) goes into formats that record one.
+    const std::optional<SensorSize> sensor = reader->sensor();
+    const auto writer = io::open_event_writer(o.output, to, sensor);
+    Progress progress(!o.quiet && !o.no_progress, reader->bytes_total());
     std::vector<Event> buf(kBatch);
     std::uint64_t events = 0;
+    int max_x = -1, max_y = -1;
+    auto finish = [&] {
+        progress.finish();
+        if (!sensor) writer->set_sensor(fallback_size(max_x, max_y, to, writer->name()));
+        writer->close();
+    };
     try {
         for (;;) {
             const std::size_t n = reader->read(buf);
             if (n == 0 && reader->skipped_in_batch().empty()) break;
-            writer->write(std::span<const Event>(buf.data(), n));
+            const std::span<const Event> batch(buf.data(), n);
+            if (!sensor)
+                for (const Event& e : batch) {
+                    max_x = std::max<int>(max_x, e.x);
+                    max_y = std::max<int>(max_y, e.y);
+                }
+            writer->write(batch);
             events += n;
+            progress.update(reader->bytes_consumed(), events);
         }
     } catch (const InputError& e) {
         if (!o.allow_damaged) {
-            writer->close();
+            finish();
             fmt::print(stderr, "evcorner: the {} events before the error are written to {}\n", events, writer->name());
             throw;
         }
+        progress.finish();
         fmt::print(stderr, "evcorner: warning: {}; the {} events before it are written\n", e.what(), events);
     }
-    writer->close();
+    finish();
     if (!o.quiet) {
         fmt::print(stderr, "evcorner convert: {} ({}) -> {} ({}): {} events", reader->name(), reader->format(),
                    writer->name(), to, events);
@@ -76,19 +108,37 @@ void run_convert(const ConvertOptions& o) {
 
 }  // namespace
 
+void add_output_format_option(CLI::App& cmd, std::string& to) {
+    cmd.add_option("--to", to,
+                   "Output format: auto (by extension; none = ecd-text), " + std::string(io::kOutputFormats))
+        ->capture_default_str()
+        ->check([](const std::string& name) {
+            try {
+                if (name != "auto") (void)io::resolve_output_format("", name);
+                return std::string();
+            } catch (const std::invalid_argument& e) {
+                return std::string(e.what());
+            }
+        });
+}
+
 void add_convert_command(CLI::App& app) {
     auto o = std::make_shared<ConvertOptions>();
     CLI::App* cmd = app.add_subcommand(
         "convert",
         "Convert an event file to another format.\n"
         "The input format is told by the content (or --format); the output format by OUTPUT's\n"
-        "extension (.txt, .csv, .npy, .aedat4, .h5) or --to.");
+        "extension (.txt, .csv, .npy, .aedat4, .h5, .hdf5; another extension is refused) or\n"
+        "--to; a name without extension, and - (standard output), get ECD text.\n"
+        "AEDAT 4.0 and HDF5 outputs record the sensor size: the input's, else --size, else\n"
+        "240x180 (the DAVIS240C, as detect assumes) when every event fits, else the events'\n"
+        "bounding box (with a warning). The output appears under its name only when complete.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     cmd->add_option("OUTPUT", o->output, "Output file (- = standard output, text formats)")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
-    cmd->add_option("--to", o->to, "Output format: auto (by extension), " + std::string(io::kOutputFormats))
-        ->capture_default_str();
-    cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
+    add_output_format_option(*cmd, o->to);
+    cmd->add_option("--size", o->size,
+                    "Sensor size WxH to check events against (overrides the file's) and to record")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
         });
@@ -96,7 +146,8 @@ void add_convert_command(CLI::App& app) {
     cmd->add_flag("--allow-damaged", o->allow_damaged,
                   "A damaged or cut-short input ends with a warning and exit status 0, instead of an "
                   "error: the events before the damage are the output");
-    cmd->add_flag("-q,--quiet", o->quiet, "No summary line");
+    cmd->add_flag("-q,--quiet", o->quiet, "No summary line and no progress bar");
+    cmd->add_flag("--no-progress", o->no_progress, "No progress bar (it shows only on a terminal)");
     cmd->footer("Examples:\n  evcorner convert recording.aedat events.npy\n  evcorner convert events.raw - --to csv | head");
     cmd->callback([o] { run_convert(*o); });
 }

@@ -20,6 +20,7 @@
 #include "evcorner/io/event_writer.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/open.hpp"
+#include "evcorner/io/output_paths.hpp"
 #include "evcorner/io/text_writer.hpp"
 #include "evcorner/parallel_detect.hpp"
 #include "evcorner/scored_detector.hpp"
@@ -131,6 +132,10 @@ void write_summary_json(const DetectOptions& o, SensorSize size, const Totals& t
 
 void run_detect(const DetectOptions& o) {
     const auto wall_start = Clock::now();
+    // Before anything is opened: outputs onto the input or onto each other, and the format.
+    io::check_output_paths({{"INPUT", o.input}},
+                           {{"-o", o.output}, {"--mask", o.mask}, {"--summary-json", o.summary_json}});
+    const std::string to = io::resolve_output_format(o.output, o.to);
     io::ReaderOptions ropts;
     ropts.skip_invalid = o.skip_invalid;
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);  // validated by CLI11
@@ -149,20 +154,16 @@ void run_detect(const DetectOptions& o) {
                                     "' is not local (efast and harris split the sensor; harris-global cannot)");
     if (o.threads > 1 && o.with_score)
         throw std::invalid_argument("--threads: --with-score needs one thread");
-    std::string to = o.to;
-    if (to == "auto") {
-        to = io::output_format_for(o.output);
-        if (to.empty()) to = "ecd-text";
-    }
-    // Scores only fit the text lines ("t x y p score"); every other format takes events.
+    // Scores only fit the text lines ("t x y p score"); every other format takes events,
+    // and records the sensor size the detector ran on where it has a field for it.
     std::unique_ptr<io::TextWriter> scored_out;
     std::unique_ptr<io::EventWriter> corners_out;
     if (o.with_score) {
-        if (to != "ecd-text" && to != "text")
+        if (to != "ecd-text")
             throw std::invalid_argument("--with-score writes 't x y p score' text lines; it cannot write " + to);
         scored_out = std::make_unique<io::TextWriter>(o.output);
     } else {
-        corners_out = io::open_event_writer(o.output, to);
+        corners_out = io::open_event_writer(o.output, to, size);
     }
     std::unique_ptr<io::OutputFile> mask_out;
     if (!o.mask.empty()) mask_out = std::make_unique<io::OutputFile>(o.mask);
@@ -353,11 +354,10 @@ void add_detect_command(CLI::App& app) {
         });
     cmd->add_option("-o,--output", o->output,
                     "Corner events (- = standard output, as 't x y p' lines); the format follows the "
-                    "extension (.txt, .csv, .npy)")
+                    "extension (.txt, .csv, .npy, .aedat4, .h5, .hdf5; others are refused; none = text). "
+                    "AEDAT 4.0 and HDF5 record the sensor size the detector ran on")
         ->capture_default_str();
-    cmd->add_option("--to", o->to, "Output format: auto (by extension, else ecd-text), " +
-                                       std::string(io::kOutputFormats))
-        ->capture_default_str();
+    add_output_format_option(*cmd, o->to);
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
     cmd->add_option("--size", o->size,
                     "Sensor size WxH; events outside it are errors [default: the file's own "
@@ -370,7 +370,8 @@ void add_detect_command(CLI::App& app) {
                     "Also write one line per input event: 1 = corner, 0 = not (skipped events: 0)");
     cmd->add_option("--summary-json", o->summary_json,
                     "Also write the summary as JSON (keys include events, corners, "
-                    "reduction_rate [%], ns_per_event)");
+                    "reduction_rate [%], ns_per_event). No two outputs may share a file or both be - "
+                    "(standard output), and none may be the input");
     cmd->add_flag("--with-score", o->with_score,
                   "Append the detector's score to each corner line ('t x y p score'); harris and "
                   "harris-global only");

@@ -15,13 +15,16 @@
 #include "evcorner/error.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
+#include "evcorner/io/output_paths.hpp"
+#include "progress.hpp"
+#include "std_streams.hpp"
 
 namespace evcorner::cli {
 
 namespace {
 
 constexpr std::size_t kBatch = 1 << 16;
-constexpr std::int64_t kPeakBinUs = 1000;  // peak rate: the busiest 1 ms bin
+constexpr std::int64_t kPeakBinUs = 1000;  // peak rate: the busiest 1 ms
 
 struct InfoOptions {
     std::string input;
@@ -31,16 +34,55 @@ struct InfoOptions {
     std::string time_unit = "us";
     std::string json;
     bool skip_invalid = false;
+    bool no_progress = false;
+};
+
+// The peak rate, streamed. The span t_first..t_last is cut into 1 ms bins from t_first;
+// the remainder under 1 ms joins the last bin (a span under 1 ms is one bin). The bins
+// tile the span, so the busiest bin's rate (events / its length) is never below the
+// mean rate (events / span): the largest of several ratios is at least the ratio of
+// their sums.
+class PeakRate {
+public:
+    void add(std::int64_t t_from_first) {
+        const std::int64_t b = t_from_first / kPeakBinUs;
+        if (b != bin_) {
+            // Bin `bin_` is complete; it stays the one before last only if b follows it.
+            max_full_ = std::max(max_full_, before_last_);
+            before_last_ = b == bin_ + 1 ? in_bin_ : 0;
+            if (b != bin_ + 1) max_full_ = std::max(max_full_, in_bin_);
+            bin_ = b;
+            in_bin_ = 0;
+        }
+        ++in_bin_;
+    }
+    /// Events per second; 0 for a span of 0.
+    [[nodiscard]] double rate(std::int64_t span_us) const {
+        if (span_us <= 0) return 0.0;
+        if (bin_ == 0) return static_cast<double>(in_bin_) * 1e6 / static_cast<double>(span_us);
+        // Every complete bin but the one before last, then that one merged with the remainder.
+        const double full = static_cast<double>(max_full_) * 1e6 / kPeakBinUs;
+        const auto merged_us = static_cast<double>(span_us - (bin_ - 1) * kPeakBinUs);
+        const double merged = static_cast<double>(before_last_ + in_bin_) * 1e6 / merged_us;
+        return std::max(full, merged);
+    }
+
+private:
+    std::int64_t bin_ = 0;
+    std::uint64_t in_bin_ = 0;      // events in bin_
+    std::uint64_t before_last_ = 0; // events in bin_ - 1
+    std::uint64_t max_full_ = 0;    // the most events in a bin before bin_ - 1
 };
 
 struct Stats {
     std::uint64_t events = 0, on = 0, skipped = 0;
     std::int64_t t_first = 0, t_last = 0;
     int x_min = 65535, x_max = 0, y_min = 65535, y_max = 0;
-    std::uint64_t peak_bin = 0;
+    PeakRate peak;
 };
 
 void run_info(const InfoOptions& o) {
+    if (!o.json.empty()) io::check_output_paths({{"INPUT", o.input}}, {{"--json", o.json}});
     io::ReaderOptions ropts;
     ropts.skip_invalid = o.skip_invalid;
     ropts.fallback_sensor = std::nullopt;  // describe any file, whatever its size
@@ -48,11 +90,12 @@ void run_info(const InfoOptions& o) {
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
+    // With the JSON on standard output, the table goes to standard error.
+    std::FILE* human = o.json == "-" ? stderr : stdout;
 
     Stats s;
+    Progress progress(!o.no_progress, reader->bytes_total());
     std::vector<Event> buf(kBatch);
-    std::int64_t bin = INT64_MIN;
-    std::uint64_t in_bin = 0;
     for (;;) {
         const std::size_t n = reader->read(buf);
         if (n == 0 && reader->skipped_in_batch().empty()) break;
@@ -65,38 +108,36 @@ void run_info(const InfoOptions& o) {
             s.x_max = std::max<int>(s.x_max, e.x);
             s.y_min = std::min<int>(s.y_min, e.y);
             s.y_max = std::max<int>(s.y_max, e.y);
-            const std::int64_t b = (e.t - s.t_first) / kPeakBinUs;
-            if (b != bin) {
-                bin = b;
-                in_bin = 0;
-            }
-            s.peak_bin = std::max(s.peak_bin, ++in_bin);
+            s.peak.add(e.t - s.t_first);
         }
         s.t_last = buf[n - 1].t;
         s.events += n;
+        progress.update(reader->bytes_consumed(), s.events);
     }
+    progress.finish();
     s.skipped = reader->skipped();
 
     const double span_s = static_cast<double>(s.t_last - s.t_first) * 1e-6;
     const double mean_rate = span_s > 0 ? static_cast<double>(s.events) / span_s : 0.0;
-    const double peak_rate = static_cast<double>(s.peak_bin) * (1e6 / kPeakBinUs);
+    const double peak_rate = s.peak.rate(s.t_last - s.t_first);
     const auto sensor = reader->sensor();
 
-    fmt::print("file         {}\n", reader->name());
-    fmt::print("format       {}\n", reader->format());
-    if (sensor) fmt::print("sensor       {}x{}\n", sensor->width, sensor->height);
-    else fmt::print("sensor       unknown (the file does not say; pass --size to check events)\n");
-    fmt::print("events       {}\n", s.events);
-    if (s.skipped > 0) fmt::print("skipped      {} (outside the sensor)\n", s.skipped);
+    fmt::print(human, "file         {}\n", reader->name());
+    fmt::print(human, "format       {}\n", reader->format());
+    if (sensor) fmt::print(human, "sensor       {}x{}\n", sensor->width, sensor->height);
+    else fmt::print(human, "sensor       unknown (the file does not say; pass --size to check events)\n");
+    fmt::print(human, "events       {}\n", s.events);
+    if (s.skipped > 0) fmt::print(human, "skipped      {} (outside the sensor)\n", s.skipped);
     if (s.events > 0) {
-        fmt::print("time         {} .. {} us\n", s.t_first, s.t_last);
-        fmt::print("span         {:.6f} s\n", span_s);
-        fmt::print("mean rate    {:.3f} M events/s\n", mean_rate * 1e-6);
-        fmt::print("peak rate    {:.3f} M events/s (busiest 1 ms)\n", peak_rate * 1e-6);
-        fmt::print("ON / OFF     {} / {}\n", s.on, s.events - s.on);
-        fmt::print("x range      {}..{}\n", s.x_min, s.x_max);
-        fmt::print("y range      {}..{}\n", s.y_min, s.y_max);
+        fmt::print(human, "time         {} .. {} us\n", s.t_first, s.t_last);
+        fmt::print(human, "span         {:.6f} s\n", span_s);
+        fmt::print(human, "mean rate    {:.3f} M events/s\n", mean_rate * 1e-6);
+        fmt::print(human, "peak rate    {:.3f} M events/s (busiest 1 ms)\n", peak_rate * 1e-6);
+        fmt::print(human, "ON / OFF     {} / {}\n", s.on, s.events - s.on);
+        fmt::print(human, "x range      {}..{}\n", s.x_min, s.x_max);
+        fmt::print(human, "y range      {}..{}\n", s.y_min, s.y_max);
     }
+    flush_checked(human);
     if (!o.json.empty()) {
         nlohmann::json j;
         j["file"] = reader->name();
@@ -130,7 +171,13 @@ void run_info(const InfoOptions& o) {
 void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit) {
     cmd.add_option("--format", format,
                    "Input format: auto (from the content), " + std::string(io::kInputFormats))
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check([](const std::string& name) {
+            // The names open_event_reader() takes, and its aliases.
+            std::string known = ", auto, text, aedat, h5, " + std::string(io::kInputFormats) + ",";
+            if (known.find(", " + name + ",") != std::string::npos) return std::string();
+            return "unknown input format '" + name + "' (known: auto, " + std::string(io::kInputFormats) + ")";
+        });
     cmd.add_option("--csv-columns", csv_columns,
                    "CSV column order, e.g. x,y,p,t ('_' skips a column) [default: the header row, else t,x,y,p]");
     cmd.add_option("--time-unit", time_unit, "CSV time unit: us, ns, ms or s")
@@ -144,7 +191,10 @@ void add_info_command(CLI::App& app) {
         "info",
         "Describe an event file: format, sensor size, events, time span, rates, ON/OFF.\n"
         "Prints the format, sensor size, events, time span, mean and peak rate, ON/OFF counts\n"
-        "and x/y ranges. Reads the whole file once, in constant memory.");
+        "and x/y ranges. Reads the whole file once, in constant memory.\n"
+        "Mean rate: events / (last time - first time). Peak rate: the busiest 1 ms bin, bins\n"
+        "cut from the first event, the remainder under 1 ms joined to the last bin (a span\n"
+        "under 1 ms is one bin), in events per second of the bin's length: never below the mean.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
@@ -152,7 +202,10 @@ void add_info_command(CLI::App& app) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
         });
     cmd->add_flag("--skip-invalid", o->skip_invalid, "Skip (and count) events outside --size instead of failing");
-    cmd->add_option("--json", o->json, "Also write the figures as JSON to this file (- = standard output)");
+    cmd->add_option("--json", o->json,
+                    "Also write the figures as JSON to this file (- = standard output; the table then "
+                    "goes to standard error)");
+    cmd->add_flag("--no-progress", o->no_progress, "No progress bar (it shows only on a terminal)");
     cmd->footer("Example:\n  evcorner info recording.raw");
     cmd->callback([o] { run_info(*o); });
 }

@@ -1,12 +1,82 @@
 // evcorner: corner detection on event-camera streams.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <exception>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
+#include <vector>
 
 #include "commands.hpp"
+#include "std_streams.hpp"
+
+using evcorner::cli::finish_stdout;
+
+namespace {
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diag = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            diag = up;
+        }
+    }
+    return row[b.size()];
+}
+
+// "unknown command 'detec'; did you mean 'detect'?" for a first argument that names no
+// command; empty when it is one (or an option).
+std::string unknown_command(CLI::App& app, const std::string& word) {
+    if (word.empty() || word[0] == '-') return {};
+    std::vector<std::string> names;
+    for (const CLI::App* cmd : app.get_subcommands({})) {
+        if (cmd->check_name(word)) return {};
+        names.push_back(cmd->get_name());
+    }
+    std::string best;
+    std::size_t best_d = std::string::npos;
+    for (const auto& n : names) {
+        std::string lower = word;  // "DETECT" is a slip too
+        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        const std::size_t d = lower == n ? 1 : edit_distance(lower, n);
+        if (d < best_d) {
+            best_d = d;
+            best = n;
+        }
+    }
+    std::string msg = "unknown command '" + word + "'";
+    // Close enough to be a slip: at most 2 edits, and fewer than half the word.
+    if (best_d <= 2 && 2 * best_d < std::max(word.size(), best.size())) return msg + "; did you mean '" + best + "'?";
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    return msg + " (commands: " + list + ")";
+}
+
+// Help and version text, through stdio so that a failed write keeps its errno.
+int print_help(const CLI::App& app, const CLI::Error& e) {
+    std::ostringstream text;
+    const int status = app.exit(e, text);
+    const std::string s = text.str();
+    errno = 0;
+    if (std::fwrite(s.data(), 1, s.size(), stdout) != s.size()) {
+        std::fprintf(stderr, "evcorner: error: <stdout>: write failed: %s\n", std::strerror(errno));
+        return 1;
+    }
+    return finish_stdout(status);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{
@@ -40,24 +110,40 @@ int main(int argc, char** argv) {
         cmd->footer(text.substr(nl + 1) + "\n\n" + cmd->get_footer());
         cmd->description(text.substr(0, nl));
     }
+    if (argc > 1) {
+        const std::string msg = unknown_command(app, argv[1]);
+        if (!msg.empty()) {
+            std::fprintf(stderr, "evcorner: error: %s\nRun with --help for more information.\n", msg.c_str());
+            return 2;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
+        return print_help(app, e);
     } catch (const CLI::CallForAllHelp& e) {
-        return app.exit(e);
+        return print_help(app, e);
     } catch (const CLI::CallForVersion& e) {
-        return app.exit(e);
+        return print_help(app, e);
     } catch (const CLI::ParseError& e) {
         app.exit(e);
-        return 2;
+        return finish_stdout(2);
     } catch (const std::invalid_argument& e) {
-        // A parameter out of range, caught when the detector or writer is built.
+        // A parameter out of range, caught when the detector or writer is built, or
+        // outputs that would overwrite an input or each other (checked before opening).
         std::fprintf(stderr, "evcorner: error: %s\n", e.what());
-        return 2;
+        return finish_stdout(2);
+    } catch (const std::system_error& e) {
+        // fmt::print reports a failed write to a stream this way.
+        if (std::ferror(stdout)) {
+            std::fprintf(stderr, "evcorner: error: <stdout>: write failed: %s\n", e.code().message().c_str());
+            return 1;
+        }
+        std::fprintf(stderr, "evcorner: error: %s\n", e.what());
+        return finish_stdout(1);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "evcorner: error: %s\n", e.what());
-        return 1;
+        return finish_stdout(1);
     }
-    return 0;
+    return finish_stdout(0);
 }

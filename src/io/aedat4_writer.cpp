@@ -1,10 +1,8 @@
 #include "evcorner/io/aedat4_writer.hpp"
 
-#include <fcntl.h>
 #include <lz4frame.h>
-#include <unistd.h>
 
-#include <cerrno>
+#include <algorithm>
 #include <cstring>
 #include <fmt/format.h>
 
@@ -119,15 +117,23 @@ Aedat4Writer::Aedat4Writer(std::string path, Options options)
     if (options_.sensor && (options_.sensor->width > 32768 || options_.sensor->height > 32768))
         throw OutputError(out_.name(), "AEDAT 4.0 coordinates are int16: the sensor must be at most 32768x32768");
     packet_.resize(kPacketHead + options_.packet_events * kEventBytes);
+    rewrite_header_ = !options_.sensor;
     out_.write(kAedat4Magic);
     out_.write(io_header(options_.compression, options_.sensor.value_or(SensorSize{1, 1})));
 }
 
-Aedat4Writer::~Aedat4Writer() {
-    try {
-        close();
-    } catch (...) {
-    }
+Aedat4Writer::~Aedat4Writer() = default;  // without close(), out_ removes the unfinished file
+
+void Aedat4Writer::set_sensor(SensorSize size) {
+    if (size.width < 1 || size.height < 1 || size.width > 32768 || size.height > 32768)
+        throw OutputError(out_.name(), fmt::format("sensor {}x{}: AEDAT 4.0 sizes are 1..32768 per side", size.width,
+                                                   size.height));
+    if (max_x_ >= size.width || max_y_ >= size.height)
+        throw OutputError(out_.name(), fmt::format("an event written at x={} y={} lies outside the {}x{} sensor",
+                                                   max_x_, max_y_, size.width, size.height));
+    if (options_.sensor == size) return;
+    options_.sensor = size;
+    rewrite_header_ = true;
 }
 
 void Aedat4Writer::write(std::span<const Event> events) {
@@ -174,20 +180,14 @@ void Aedat4Writer::flush_packet() {
 
 void Aedat4Writer::close() {
     if (closed_) return;
-    closed_ = true;
     flush_packet();
+    if (rewrite_header_) {
+        // The header is the same length whatever the size (kXmlLength): rewritten in place.
+        const SensorSize size = options_.sensor.value_or(SensorSize{std::max(max_x_ + 1, 1), std::max(max_y_ + 1, 1)});
+        out_.write_at(kAedat4Magic.size(), io_header(options_.compression, size));
+    }
     out_.close();
-    if (options_.sensor) return;
-    const SensorSize size{std::max(max_x_ + 1, 1), std::max(max_y_ + 1, 1)};
-    const std::string header = io_header(options_.compression, size);
-    const int fd = ::open(out_.name().c_str(), O_WRONLY | O_CLOEXEC);
-    if (fd < 0)
-        throw OutputError(out_.name(), std::string("cannot reopen to write the sensor size: ") + std::strerror(errno));
-    const ssize_t w = ::pwrite(fd, header.data(), header.size(), static_cast<off_t>(kAedat4Magic.size()));
-    const int err = errno;
-    ::close(fd);
-    if (w != static_cast<ssize_t>(header.size()))
-        throw OutputError(out_.name(), std::string("cannot rewrite the header: ") + std::strerror(err));
+    closed_ = true;
 }
 
 }  // namespace evcorner::io

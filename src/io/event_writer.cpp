@@ -1,5 +1,7 @@
 #include "evcorner/io/event_writer.hpp"
 
+#include <stdexcept>
+
 #include "evcorner/error.hpp"
 #include "evcorner/io/aedat4_writer.hpp"
 #include "evcorner/io/hdf5_events.hpp"
@@ -42,14 +44,31 @@ std::string output_format_for(const std::string& path) {
     return "";
 }
 
+std::string resolve_output_format(const std::string& path, std::string_view format) {
+    if (format == "auto") {
+        std::string f = output_format_for(path);
+        if (!f.empty()) return f;
+        // The extension as std::filesystem sees it: after the last '.' of the last
+        // component, unless that '.' starts it (".hidden" has none).
+        const auto slash = path.find_last_of('/');
+        const std::string last = slash == std::string::npos ? path : path.substr(slash + 1);
+        const auto dot = last.find_last_of('.');
+        if (dot == std::string::npos || dot == 0 || last == "..") return "ecd-text";
+        throw std::invalid_argument("output " + path + ": unknown extension '" + last.substr(dot) + "' (known: " +
+                                    std::string(kOutputExtensions) + "; or name the format with --to: " +
+                                    std::string(kOutputFormats) + ")");
+    }
+    if (format == "ecd-text" || format == "text") return "ecd-text";
+    if (format == "h5" || format == "hdf5") return "hdf5";
+    if (format == "csv" || format == "npy" || format == "aedat4") return std::string(format);
+    throw std::invalid_argument("unknown output format '" + std::string(format) + "' (known: auto, " +
+                                std::string(kOutputFormats) + ")");
+}
+
 std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format,
                                                std::optional<SensorSize> sensor) {
-    std::string f(format);
-    if (f == "auto") {
-        f = output_format_for(path);
-        if (f.empty()) f = "ecd-text";
-    }
-    if (f == "ecd-text" || f == "text") return std::make_unique<TextEventWriter>(path);
+    const std::string f = resolve_output_format(path, format);
+    if (f == "ecd-text") return std::make_unique<TextEventWriter>(path);
     if (f == "csv") return std::make_unique<CsvWriter>(path);
     if (f == "npy") return std::make_unique<NpyWriter>(path);
     if (f == "aedat4") {
@@ -57,13 +76,9 @@ std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::str
         o.sensor = sensor;
         return std::make_unique<Aedat4Writer>(path, o);
     }
-    if (f == "hdf5" || f == "h5") {
-        Hdf5Writer::Options o;
-        o.sensor = sensor;
-        return std::make_unique<Hdf5Writer>(path, o);
-    }
-    throw OutputError(path == "-" ? "<stdout>" : path,
-                      "unknown output format '" + f + "' (known: " + std::string(kOutputFormats) + ")");
+    Hdf5Writer::Options o;
+    o.sensor = sensor;
+    return std::make_unique<Hdf5Writer>(path, o);
 }
 
 }  // namespace evcorner::io

@@ -1,15 +1,19 @@
 #include "evcorner/io/hdf5_events.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fmt/format.h>
 #include <utility>
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/pending_file.hpp"
 
 namespace evcorner::io {
 
@@ -50,6 +54,52 @@ auto quiet(F&& f) {
     return r;
 }
 
+// HDF5 prints its error stack to standard error on failure, also from the library's own
+// clean-up at exit, where no H5E_BEGIN_TRY reaches: switched off once for the process
+// (evcorner reports every failure itself, with hdf5_reason()). And that clean-up at exit
+// is not registered (H5dont_atexit, which must come before HDF5's first call): after a
+// write failure libhdf5 1.10 keeps a file it cannot close, and its clean-up then crashes
+// or prints "infinite loop closing library". Every file evcorner opens is closed by
+// its reader or writer; the operating system takes back the rest at exit.
+void silence_hdf5() {
+    static const bool done = [] {
+        H5dont_atexit();
+        H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+        return true;
+    }();
+    (void)done;
+}
+
+// Why the last HDF5 call failed, from its error stack: the operating system's message
+// where HDF5 recorded one ("errno = 28, error message = 'No space left on device'"),
+// else the description of the innermost error (where it was detected). `err`: errno
+// right after the call, the fallback.
+std::string hdf5_reason(int err = 0) {
+    struct Found {
+        std::string system, innermost;
+    } found;
+    H5Ewalk2(
+        H5E_DEFAULT, H5E_WALK_UPWARD,
+        [](unsigned n, const H5E_error2_t* e, void* data) -> herr_t {
+            auto& f = *static_cast<Found*>(data);
+            const std::string desc = e->desc ? e->desc : "";
+            if (n == 0) f.innermost = desc;
+            const std::string key = "error message = '";
+            const auto at = desc.find(key);
+            if (f.system.empty() && at != std::string::npos) {
+                const auto end = desc.find('\'', at + key.size());
+                f.system = desc.substr(at + key.size(), end == std::string::npos ? std::string::npos : end - at - key.size());
+            }
+            return 0;
+        },
+        &found);
+    H5Eclear2(H5E_DEFAULT);
+    if (!found.system.empty()) return found.system;
+    if (!found.innermost.empty()) return found.innermost;
+    if (err != 0) return std::strerror(err);
+    return "reason unknown";
+}
+
 bool link_exists(hid_t loc, const char* name) { return quiet([&] { return H5Lexists(loc, name, H5P_DEFAULT); }) > 0; }
 
 // The Debian package that holds an HDF5 filter plugin.
@@ -85,13 +135,14 @@ struct Hdf5Reader::Impl {
 
 Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
     : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdin>" : path), options_(std::move(options)) {
+    silence_hdf5();
     if (path == "-") throw InputError(name_, "HDF5 files cannot be read from standard input");
     file_size_ = regular_file_size(path);
     if (!file_size_) throw InputError(name_, "cannot open: not a regular file, or missing");
     if (quiet([&] { return H5Fis_hdf5(path.c_str()); }) <= 0)
         throw InputError(name_, InputError::Unit::byte, 0, "not an HDF5 file (no HDF5 signature)");
     impl_->file = Hid(quiet([&] { return H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT); }), H5Fclose);
-    if (!impl_->file.ok()) throw InputError(name_, "HDF5 cannot open the file (damaged?)");
+    if (!impl_->file.ok()) throw InputError(name_, "HDF5 cannot open the file (damaged?): " + hdf5_reason(errno));
     const hid_t f = impl_->file.get();
     if (!link_exists(f, "events")) throw InputError(name_, "no 'events' group: not a DSEC or event_utils HDF5 file");
     static const char* dsec[4] = {"events/x", "events/y", "events/t", "events/p"};
@@ -106,7 +157,8 @@ Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
     for (int i = 0; i < 4; ++i) {
         impl_->names[i] = names[i];
         impl_->dset[i] = Hid(quiet([&] { return H5Dopen2(f, names[i], H5P_DEFAULT); }), H5Dclose);
-        if (!impl_->dset[i].ok()) throw InputError(name_, fmt::format("cannot open dataset {}", names[i]));
+        if (!impl_->dset[i].ok())
+            throw InputError(name_, fmt::format("cannot open dataset {}: {}", names[i], hdf5_reason()));
         const hid_t d = impl_->dset[i].get();
         Hid space(H5Dget_space(d), H5Sclose);
         hsize_t dims[2] = {0, 0};
@@ -267,7 +319,9 @@ void Hdf5Reader::load_chunk() {
                 r = quiet([&] { return H5Dread(d, H5T_NATIVE_INT32, mem.get(), space.get(), H5P_DEFAULT, p_.data()); });
             }
         }
-        if (r < 0) fail_at(chunk_start_, i, "HDF5 cannot read these events (damaged data, or a filter that fails)");
+        if (r < 0)
+            fail_at(chunk_start_, i,
+                    "HDF5 cannot read these events (damaged data, or a filter that fails): " + hdf5_reason(errno));
     }
     if (impl_->t_float) {
         for (std::size_t k = 0; k < chunk_n_; ++k) {
@@ -319,23 +373,61 @@ std::size_t Hdf5Reader::read(std::span<Event> out) {
 // ---------------------------------------------------------------- writer
 
 struct Hdf5Writer::Impl {
+    // Declared first, destroyed last: the HDF5 file is closed before an unfinished
+    // temporary file is removed.
+    std::optional<PendingFile> pending;
     Hid file, group;
     Hid dset[4];  // x, y, t, p
+
+    // Gives up the file (a failed write, or no close()): its content no longer matters.
+    // libhdf5 1.10 cannot close a file whose writes fail: H5Fclose fails, the file stays
+    // open, and the library's own clean-up at exit then crashes (or prints "infinite loop
+    // closing library"). So the file's descriptor is first pointed at /dev/null, where
+    // every write succeeds, and then everything is closed; the temporary file is removed
+    // afterwards by `pending`.
+    void abandon() noexcept {
+        if (file.ok()) {
+            void* handle = nullptr;
+            if (quiet([&] { return H5Fget_vfd_handle(file.get(), H5P_DEFAULT, &handle); }) >= 0 && handle) {
+                const int fd = *static_cast<int*>(handle);
+                const int null = ::open("/dev/null", O_RDWR | O_CLOEXEC);
+                if (null >= 0) {
+                    ::dup2(null, fd);
+                    ::close(null);
+                }
+            }
+        }
+        for (auto& d : dset) d = Hid();
+        group = Hid();
+        file = Hid();
+    }
+    ~Impl() { abandon(); }
 };
 
 bool Hdf5Writer::filter_available(int id) {
+    silence_hdf5();
     return quiet([&] { return H5Zfilter_avail(static_cast<H5Z_filter_t>(id)); }) > 0;
 }
 
 Hdf5Writer::Hdf5Writer(std::string path, Options options)
     : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdout>" : path), options_(options) {
+    silence_hdf5();
     if (path == "-") throw OutputError(name_, "HDF5 files cannot go to standard output");
     if (options_.chunk_events == 0) options_.chunk_events = std::size_t{1} << 14;
-    impl_->file = Hid(quiet([&] { return H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT); }), H5Fclose);
-    if (!impl_->file.ok()) throw OutputError(name_, "HDF5 cannot create the file");
+    // HDF5 writes a temporary file in the target's folder (pending_file.hpp), renamed by close().
+    impl_->pending.emplace(path);
+    if (impl_->pending->direct())
+        throw OutputError(name_, "an HDF5 file must be a regular file (HDF5 seeks back to complete it); "
+                                 "this path is a device, FIFO or socket");
+    impl_->pending->close_fd();  // HDF5 opens the file by name
+    impl_->file = Hid(quiet([&] {
+                          return H5Fcreate(impl_->pending->write_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+                      }),
+                      H5Fclose);
+    if (!impl_->file.ok()) throw OutputError(name_, "HDF5 cannot create the file: " + hdf5_reason(errno));
     impl_->group = Hid(quiet([&] { return H5Gcreate2(impl_->file.get(), "events", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT); }),
                        H5Gclose);
-    if (!impl_->group.ok()) throw OutputError(name_, "HDF5 cannot create the events group");
+    if (!impl_->group.ok()) throw OutputError(name_, "HDF5 cannot create the events group: " + hdf5_reason(errno));
     const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = options_.chunk_events;
     Hid space(H5Screate_simple(1, &zero, &unlimited), H5Sclose);
     Hid dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
@@ -349,7 +441,7 @@ Hdf5Writer::Hdf5Writer(std::string path, Options options)
         const unsigned cd[7] = {0, 0, 0, 0, 5, 1, 5};
         if (quiet([&] { return H5Pset_filter(dcpl.get(), static_cast<H5Z_filter_t>(options_.filter), H5Z_FLAG_MANDATORY,
                                               options_.filter == 32001 ? 7 : 0, cd); }) < 0)
-            throw OutputError(name_, fmt::format("HDF5 cannot set filter {}", options_.filter));
+            throw OutputError(name_, fmt::format("HDF5 cannot set filter {}: {}", options_.filter, hdf5_reason()));
     }
     const char* names[4] = {"x", "y", "t", "p"};
     const hid_t types[4] = {H5T_STD_U16LE, H5T_STD_U16LE, H5T_STD_I64LE, H5T_STD_U8LE};
@@ -357,7 +449,8 @@ Hdf5Writer::Hdf5Writer(std::string path, Options options)
         impl_->dset[i] = Hid(quiet([&] { return H5Dcreate2(impl_->group.get(), names[i], types[i], space.get(), H5P_DEFAULT,
                                                            dcpl.get(), H5P_DEFAULT); }),
                              H5Dclose);
-        if (!impl_->dset[i].ok()) throw OutputError(name_, fmt::format("HDF5 cannot create events/{}", names[i]));
+        if (!impl_->dset[i].ok())
+            throw OutputError(name_, fmt::format("HDF5 cannot create events/{}: {}", names[i], hdf5_reason(errno)));
     }
     x_.reserve(options_.chunk_events);
     y_.reserve(options_.chunk_events);
@@ -365,11 +458,12 @@ Hdf5Writer::Hdf5Writer(std::string path, Options options)
     t_.reserve(options_.chunk_events);
 }
 
-Hdf5Writer::~Hdf5Writer() {
-    try {
-        close();
-    } catch (...) {
-    }
+// Without close(): the HDF5 objects close (Impl::abandon), then the temporary file is removed.
+Hdf5Writer::~Hdf5Writer() = default;
+
+void Hdf5Writer::set_sensor(SensorSize size) {
+    if (closed_) throw OutputError(name_, "set_sensor after close");
+    options_.sensor = size;
 }
 
 void Hdf5Writer::write(std::span<const Event> events) {
@@ -392,11 +486,12 @@ void Hdf5Writer::flush() {
     const hid_t mtypes[4] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64, H5T_NATIVE_UINT8};
     for (int i = 0; i < 4; ++i) {
         const hid_t d = impl_->dset[i].get();
-        if (quiet([&] { return H5Dset_extent(d, &size); }) < 0) throw OutputError(name_, "HDF5 cannot extend a dataset");
+        if (quiet([&] { return H5Dset_extent(d, &size); }) < 0)
+            throw OutputError(name_, "HDF5 cannot extend a dataset: " + hdf5_reason(errno));
         Hid space(H5Dget_space(d), H5Sclose);
         if (quiet([&] { return H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr); }) < 0 ||
             quiet([&] { return H5Dwrite(d, mtypes[i], mem.get(), space.get(), H5P_DEFAULT, bufs[i]); }) < 0)
-            throw OutputError(name_, "HDF5 write failed");
+            throw OutputError(name_, "write failed: " + hdf5_reason(errno));
     }
     written_ += x_.size();
     x_.clear();
@@ -407,7 +502,6 @@ void Hdf5Writer::flush() {
 
 void Hdf5Writer::close() {
     if (closed_) return;
-    closed_ = true;
     flush();
     const hid_t f = impl_->file.get();
     {
@@ -417,7 +511,7 @@ void Hdf5Writer::close() {
                                             H5P_DEFAULT); }),
               H5Dclose);
         if (!d.ok() || quiet([&] { return H5Dwrite(d.get(), H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, &off); }) < 0)
-            throw OutputError(name_, "HDF5 cannot write t_offset");
+            throw OutputError(name_, "HDF5 cannot write t_offset: " + hdf5_reason(errno));
         if (options_.sensor) {
             const int wh[2] = {options_.sensor->width, options_.sensor->height};
             const char* names[2] = {"width", "height"};
@@ -425,14 +519,25 @@ void Hdf5Writer::close() {
                 Hid a(quiet([&] { return H5Acreate2(f, names[i], H5T_STD_I32LE, scalar.get(), H5P_DEFAULT, H5P_DEFAULT); }),
                       H5Aclose);
                 if (!a.ok() || quiet([&] { return H5Awrite(a.get(), H5T_NATIVE_INT, &wh[i]); }) < 0)
-                    throw OutputError(name_, "HDF5 cannot write the sensor size");
+                    throw OutputError(name_, "HDF5 cannot write the sensor size: " + hdf5_reason(errno));
             }
         }
     }
+    // Everything to the file while the file is sound: a write that fails here leaves it
+    // open and sound for Impl::abandon(), whereas a failed H5Fclose leaves HDF5 with a file
+    // it can neither close nor give up.
+    if (quiet([&] { return H5Fflush(f, H5F_SCOPE_LOCAL); }) < 0)
+        throw OutputError(name_, "write failed: " + hdf5_reason(errno));
     for (auto& ds : impl_->dset) ds = Hid();
     impl_->group = Hid();
-    const hid_t fid = impl_->file.release();
-    if (quiet([&] { return H5Fclose(fid); }) < 0) throw OutputError(name_, "HDF5 cannot complete the file");
+    if (quiet([&] { return H5Fclose(f); }) < 0) {
+        const std::string why = hdf5_reason(errno);
+        impl_->file.release();  // not to be touched again
+        throw OutputError(name_, "write failed (completing the HDF5 file): " + why);
+    }
+    impl_->file.release();
+    impl_->pending->commit();
+    closed_ = true;
 }
 
 }  // namespace evcorner::io

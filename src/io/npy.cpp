@@ -1,10 +1,6 @@
 #include "evcorner/io/npy.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cstring>
 #include <fmt/format.h>
 
@@ -48,12 +44,7 @@ NpyWriter::NpyWriter(std::string path) : out_(regular_file(std::move(path))) {
     out_.write(make_header(0));
 }
 
-NpyWriter::~NpyWriter() {
-    try {
-        close();
-    } catch (...) {
-    }
-}
+NpyWriter::~NpyWriter() = default;  // without close(), out_ removes the unfinished file
 
 void NpyWriter::write(std::span<const Event> events) {
     for (const Event& e : events) {
@@ -70,16 +61,11 @@ void NpyWriter::write(std::span<const Event> events) {
 
 void NpyWriter::close() {
     if (closed_) return;
-    closed_ = true;
+    // The count goes into the header once every event is written (a temporary file until
+    // out_.close() puts it under its name).
+    out_.write_at(0, make_header(count_));
     out_.close();
-    const std::string header = make_header(count_);
-    const int fd = ::open(out_.name().c_str(), O_WRONLY | O_CLOEXEC);
-    if (fd < 0) throw OutputError(out_.name(), std::string("cannot reopen to write the count: ") + std::strerror(errno));
-    const ssize_t n = ::pwrite(fd, header.data(), header.size(), 0);
-    const int err = errno;
-    ::close(fd);
-    if (n != static_cast<ssize_t>(header.size()))
-        throw OutputError(out_.name(), std::string("cannot write the header: ") + std::strerror(err));
+    closed_ = true;
 }
 
 NpyReader::NpyReader(std::string path, ReaderOptions options) : BinaryReader(std::move(path), options) {

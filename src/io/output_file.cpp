@@ -1,35 +1,40 @@
 #include "evcorner/io/output_file.hpp"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/pending_file.hpp"
 
 namespace evcorner::io {
 
 namespace {
 constexpr std::size_t kBufferSize = 1 << 20;
-}
+
+std::string write_failed(int err) { return std::string("write failed: ") + std::strerror(err); }
+}  // namespace
 
 OutputFile::OutputFile(std::string path) : buf_(kBufferSize) {
     if (path == "-") {
         name_ = "<stdout>";
         fd_ = STDOUT_FILENO;
+        // What went through stdio before comes first.
+        std::fflush(stdout);
     } else {
         name_ = std::move(path);
-        fd_ = ::open(name_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-        if (fd_ < 0)
-            throw OutputError(name_, std::string("cannot create: ") + std::strerror(errno));
-        owns_fd_ = true;
+        file_ = std::make_unique<PendingFile>(name_);
+        fd_ = file_->fd();
     }
 }
 
 OutputFile::~OutputFile() {
+    if (fd_ < 0) return;
+    if (file_ && !file_->direct()) return;  // file_'s destructor removes the unfinished file
     try {
-        close();
+        flush();
     } catch (...) {
     }
 }
@@ -56,24 +61,36 @@ void OutputFile::flush() {
     std::size_t done = 0;
     while (done < used_) {
         const ssize_t n = ::write(fd_, buf_.data() + done, used_ - done);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            const int err = errno;
+        if (n <= 0) {
+            if (n < 0 && errno == EINTR) continue;
+            const int err = n < 0 ? errno : EIO;
             used_ = 0;
-            throw OutputError(name_, std::string("write failed: ") + std::strerror(err));
+            throw OutputError(name_, write_failed(err));
         }
         done += static_cast<std::size_t>(n);
     }
     used_ = 0;
 }
 
+void OutputFile::write_at(std::uint64_t offset, std::string_view bytes) {
+    flush();
+    if (fd_ < 0) throw OutputError(name_, "write after close");
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+        const ssize_t n = ::pwrite(fd_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(offset + done));
+        if (n <= 0) {
+            if (n < 0 && errno == EINTR) continue;
+            throw OutputError(name_, write_failed(n < 0 ? errno : EIO));
+        }
+        done += static_cast<std::size_t>(n);
+    }
+}
+
 void OutputFile::close() {
     if (fd_ < 0) return;
     flush();
-    const int fd = fd_;
     fd_ = -1;
-    if (owns_fd_ && ::close(fd) != 0)
-        throw OutputError(name_, std::string("close failed: ") + std::strerror(errno));
+    if (file_) file_->commit();
 }
 
 }  // namespace evcorner::io

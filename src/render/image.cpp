@@ -4,8 +4,11 @@
 
 #include <cstdlib>
 #include <stdexcept>
+#include <string_view>
+#include <vector>
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/output_file.hpp"
 
 namespace evcorner::render {
 
@@ -54,18 +57,34 @@ RgbImage upscale(const RgbImage& in, int factor) {
 }
 
 // libpng's simplified API (1.6+): no setjmp in our code, errors come back in the struct.
+// The PNG is encoded in memory and written through OutputFile (a temporary file renamed
+// on success, pending_file.hpp): libpng's own file writer removes the path when a write
+// fails, even a device node or a link evcorner did not create.
 void write_png(const std::string& path, const RgbImage& image) {
     if (image.width() == 0) throw OutputError(path, "empty image");
-    png_image png{};
-    png.version = PNG_IMAGE_VERSION;
-    png.width = static_cast<png_uint_32>(image.width());
-    png.height = static_cast<png_uint_32>(image.height());
-    png.format = PNG_FORMAT_RGB;
-    if (!png_image_write_to_file(&png, path.c_str(), 0, image.bytes().data(), 0, nullptr)) {
-        const std::string reason = png.message[0] ? png.message : "cannot write PNG";
+    auto fresh = [&] {
+        png_image png{};
+        png.version = PNG_IMAGE_VERSION;
+        png.width = static_cast<png_uint_32>(image.width());
+        png.height = static_cast<png_uint_32>(image.height());
+        png.format = PNG_FORMAT_RGB;
+        return png;
+    };
+    auto fail = [&](png_image& png) {
+        const std::string reason = png.message[0] ? png.message : "cannot encode the PNG";
         png_image_free(&png);
         throw OutputError(path, reason);
-    }
+    };
+    // First call: the size the encoded image needs; second: the encoding.
+    png_image png = fresh();
+    png_alloc_size_t size = 0;
+    if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.bytes().data(), 0, nullptr)) fail(png);
+    std::vector<unsigned char> encoded(size);
+    png = fresh();
+    if (!png_image_write_to_memory(&png, encoded.data(), &size, 0, image.bytes().data(), 0, nullptr)) fail(png);
+    io::OutputFile out(path);
+    out.write(std::string_view(reinterpret_cast<const char*>(encoded.data()), size));
+    out.close();
 }
 
 RgbImage read_png(const std::string& path) {

@@ -7,8 +7,9 @@
 // in one LZ4 frame, or stored uncompressed. See aedat4_reader.hpp for the layout.
 //
 // The sensor size goes in the description. When none is given, the header is written
-// with room to spare and rewritten at close() with the smallest size holding every
-// event (max x + 1, max y + 1); such a file must be a regular file.
+// with room to spare and rewritten at close() with the size given to set_sensor(), else
+// the smallest holding every event (max x + 1, max y + 1); such a file must be seekable
+// (not standard output). The file is complete under its name only after close().
 
 #include <cstdint>
 #include <optional>
@@ -36,9 +37,12 @@ public:
     /// Creates `path` and writes the header. Throws OutputError.
     explicit Aedat4Writer(std::string path, Options options);
     explicit Aedat4Writer(std::string path) : Aedat4Writer(std::move(path), Options{}) {}
-    ~Aedat4Writer() override;
+    ~Aedat4Writer() override;  ///< without close(): no file under the name
     /// Throws OutputError for coordinates an int16 cannot hold, or outside options.sensor.
     void write(std::span<const Event> events) override;
+    /// The size to record (the header is rewritten at close() when it changes); every event
+    /// written so far and after must lie inside it. Throws OutputError.
+    void set_sensor(SensorSize size) override;
     void close() override;
     [[nodiscard]] const std::string& name() const noexcept override { return out_.name(); }
 
@@ -51,6 +55,7 @@ private:
     std::size_t pending_ = 0;
     std::vector<char> compressed_;
     int max_x_ = -1, max_y_ = -1;
+    bool rewrite_header_ = false;  // the header's size is not final: rewrite it at close()
     bool closed_ = false;
 };
 

@@ -21,6 +21,9 @@
 //
 // Errors name the file and the event index; where HDF5 tells the file address of the
 // data (contiguous storage, or the chunk holding the event), also that byte offset.
+// Failures give HDF5's reason (the system's error message where there is one, else the
+// innermost entry of HDF5's error stack); HDF5's own printing of its error stack is
+// switched off for the process the first time a reader or writer is made.
 
 #include <cstdint>
 #include <memory>
@@ -102,11 +105,14 @@ public:
     /// Whether HDF5 can use filter `id` (built in, or a plugin it finds).
     static bool filter_available(int id);
 
-    /// Creates `path` (a regular file). Throws OutputError.
+    /// Creates `path` (a regular file, written under a temporary name until close();
+    /// pending_file.hpp). Throws OutputError.
     explicit Hdf5Writer(std::string path, Options options);
     explicit Hdf5Writer(std::string path) : Hdf5Writer(std::move(path), Options{}) {}
-    ~Hdf5Writer() override;
+    ~Hdf5Writer() override;  ///< without close(): no file under the name
     void write(std::span<const Event> events) override;
+    /// The size written as the root attributes width / height at close().
+    void set_sensor(SensorSize size) override;
     void close() override;
     [[nodiscard]] const std::string& name() const noexcept override { return name_; }
 

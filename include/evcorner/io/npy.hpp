@@ -18,9 +18,10 @@ namespace evcorner::io {
 
 class NpyWriter final : public EventWriter {
 public:
-    /// Creates `path` (a regular file: the count goes in the header at close). Throws OutputError.
+    /// Creates `path` (a seekable file: the count goes in the header at close; not standard
+    /// output). Throws OutputError.
     explicit NpyWriter(std::string path);
-    ~NpyWriter() override;
+    ~NpyWriter() override;  ///< without close(): no file under the name
     void write(std::span<const Event> events) override;
     /// Writes the final event count into the header; throws OutputError.
     void close() override;

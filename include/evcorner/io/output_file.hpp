@@ -1,19 +1,29 @@
 #pragma once
 // A buffered output file, or standard output for the path "-".
+// A file is written through a PendingFile (pending_file.hpp): under a temporary name,
+// renamed onto its own name by close(); an OutputFile destroyed without close() leaves
+// nothing under the name (and the old file, if any, untouched). Standard output and
+// special files (/dev/null, FIFOs) are written directly.
 // Data reaches the file only in the pieces handed to write(); callers hand whole
-// records, so a file cut short by an error still ends on a record boundary.
+// records, so a stream cut short by an error still ends on a record boundary.
 
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace evcorner::io {
 
+class PendingFile;
+
 class OutputFile {
 public:
-    /// Creates or truncates `path` ("-" = standard output). Throws OutputError.
+    /// Creates `path` ("-" = standard output). Throws OutputError.
     explicit OutputFile(std::string path);
-    ~OutputFile();  // flushes, swallowing errors; call close() to see them
+    /// Without close(): a file is removed (its temporary name), standard output or a
+    /// special file gets the buffered data, errors swallowed. Call close() to see errors.
+    ~OutputFile();
     OutputFile(const OutputFile&) = delete;
     OutputFile& operator=(const OutputFile&) = delete;
 
@@ -23,17 +33,22 @@ public:
     char* reserve(std::size_t n);
     /// Commits n bytes written at the pointer reserve() returned.
     void commit(std::size_t n) noexcept { used_ += n; }
+    /// Flushes, then overwrites bytes at `offset` from the start (a header completed at
+    /// the end). Needs a seekable file: fails on standard output to a pipe. Throws OutputError.
+    void write_at(std::uint64_t offset, std::string_view bytes);
 
     void flush();
-    /// Flushes and closes; throws OutputError on failure. Idempotent.
+    /// Flushes and closes (puts a file under its name); throws OutputError on failure
+    /// ("write failed: reason"). Idempotent.
     void close();
 
+    /// The path given, or "<stdout>".
     [[nodiscard]] const std::string& name() const noexcept { return name_; }
 
 private:
     std::string name_;
     int fd_ = -1;
-    bool owns_fd_ = false;
+    std::unique_ptr<PendingFile> file_;  // null for standard output
     std::vector<char> buf_;
     std::size_t used_ = 0;
 };
