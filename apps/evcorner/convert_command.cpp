@@ -27,6 +27,7 @@ struct ConvertOptions {
     std::string size;
     std::string csv_columns;
     std::string time_unit = "us";
+    std::string chip;
     bool skip_invalid = false;
     bool allow_damaged = false;
     bool quiet = false;
@@ -39,6 +40,7 @@ void run_convert(const ConvertOptions& o) {
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
+    ropts.aedat2_chip = o.chip;
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
     std::string to = o.to;
     if (to == "auto") {
@@ -85,7 +87,7 @@ void add_convert_command(CLI::App& app) {
         "extension (.txt, .csv, .npy, .aedat4, .h5) or --to.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     cmd->add_option("OUTPUT", o->output, "Output file (- = standard output, text formats)")->required();
-    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
+    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
     cmd->add_option("--to", o->to, "Output format: auto (by extension), " + std::string(io::kOutputFormats))
         ->capture_default_str();
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
