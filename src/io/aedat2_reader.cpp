@@ -10,7 +10,10 @@ namespace evcorner::io {
 namespace {
 
 constexpr std::size_t kRecord = 8;
-// The records check_layout() judges the address layout on (1 MiB, the read buffer).
+// check_layout() judges the address layout on the first kLayoutWords address words found
+// among the records in the read buffer, at most kLayoutSample (1 MiB; a DAVIS file may
+// start with a frame of APS samples).
+constexpr std::uint64_t kLayoutWords = 4096;
 constexpr std::size_t kLayoutSample = std::size_t{1} << 17;
 // Fewer address words than this are too few to call them DVS128 words.
 constexpr std::uint64_t kMinDvs128Evidence = 64;
@@ -105,16 +108,20 @@ Aedat2Reader::Aedat2Reader(InputFile file, ReaderOptions options)
 // A wrong "# AEChip" line decodes the address words with the wrong layout: DAVIS words
 // read as DVS128 ones are nearly all off its 128x128 array (skipped as not DVS128
 // addresses), DAVIS words of a larger sensor fall off a smaller one, and DVS128 words
-// read as DAVIS ones all land on row 0, x < 16. Judged on the first kLayoutSample
-// records, before any event is returned, so nothing is half read.
+// read as DAVIS ones all land on row 0, x < 16. Judged before any event is returned, so
+// nothing is half read.
 void Aedat2Reader::check_layout() {
-    const std::size_t records = std::min(fill(kLayoutSample * kRecord), kLayoutSample * kRecord) / kRecord;
+    // What the read buffer holds (most of 1 MiB for a file), at least 64 KiB if the file
+    // has them: filling the buffer to the brim would move its contents for nothing.
+    const std::size_t min_bytes = 2 * kLayoutWords * kRecord;
+    const std::size_t avail = available() >= min_bytes ? available() : fill(min_bytes);
+    const std::size_t records = std::min(avail / kRecord, kLayoutSample);
     const SensorSize s = sensor().value_or(SensorSize{1024, 512});
     const auto w = static_cast<std::uint32_t>(s.width);
     const auto h = static_cast<std::uint32_t>(s.height);
     std::uint64_t words = 0, off = 0, low16 = 0;
     const unsigned char* p = data();
-    for (std::size_t i = 0; i < records; ++i, p += kRecord) {
+    for (std::size_t i = 0; i < records && words < kLayoutWords; ++i, p += kRecord) {
         const std::uint32_t a = load_be32(p);
         if (layout_ == Layout::dvs128) {
             ++words;

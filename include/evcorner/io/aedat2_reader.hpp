@@ -16,11 +16,12 @@
 // "# AEChip" line); ReaderOptions::sensor overrides the size, and a size above 128x128
 // means the DAVIS layout whatever the header says. Unless the chip is given, the header's
 // chip is checked against the data before any event is returned: when more than half of
-// the address words (DVS and special events; APS and IMU samples do not count) in the
-// first 131 072 records (1 MiB) decode outside the sensor (for DVS128: have any of
-// bits 16..31 set), or, for a DAVIS chip, more than half of at least 64 of them have
+// the first 4096 address words (DVS and special events; APS and IMU samples do not count)
+// within the first 131 072 records (1 MiB) decode outside the sensor (for DVS128: have any
+// of bits 16..31 set), or, for a DAVIS chip, more than half of at least 64 of them have
 // only their low 16 bits set (DVS128 words), the constructor throws an InputError that
-// says so and names --chip and --size. A header with no record after it is a file cut short.
+// says so and names --chip and --size. A header with no record after it is a file cut
+// short.
 
 #include <string>
 #include <string_view>
