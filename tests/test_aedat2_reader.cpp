@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <map>
+#include <stdexcept>
 
 #include "evcorner/detector.hpp"
 #include "evcorner/efast.hpp"
@@ -250,11 +253,156 @@ TEST(Aedat2Crafted, HeaderProblems) {
     o.sensor = SensorSize{64, 64};
     Aedat2Reader r(p, o);
     EXPECT_EQ(read_all(r).events.size(), 1u);
-    // Header only, no records: an empty stream.
-    Aedat2Reader empty(tmp.write("e.aedat", kDavisHeader));
-    const ReadResult er = read_all(empty);
-    EXPECT_FALSE(er.failed);
-    EXPECT_TRUE(er.events.empty());
+    // Header only, no records: the format has no end-of-header mark, so this is a file
+    // cut short at the end of a header line (issue 15, item 11), not an empty stream.
+    try {
+        Aedat2Reader empty(tmp.write("e.aedat", kDavisHeader));
+        ADD_FAILURE() << "a header without records must be an error";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.unit(), InputError::Unit::byte);
+        EXPECT_EQ(e.position(), kDavisHeader.size());
+        EXPECT_NE(std::string(e.what()).find("cut short"), std::string::npos) << e.what();
+    }
+}
+
+
+// ---- a "# AEChip" line that does not name the camera (issue 15, item 7)
+
+// `bytes` with its "# AEChip: ..." line replaced by "# AEChip: `chip`".
+std::string with_chip_line(std::string bytes, const std::string& chip) {
+    const auto at = bytes.find("# AEChip:");
+    const auto end = bytes.find('\r', at);
+    if (at == std::string::npos || end == std::string::npos) throw std::runtime_error("no AEChip line");
+    return bytes.replace(at, end - at, "# AEChip: " + chip);
+}
+
+std::string read_bytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The error names the problem and both ways out.
+void expect_chip_error(const std::string& path, const io::ReaderOptions& o, const std::string& words) {
+    try {
+        auto reader = io::open_event_reader(path, o);
+        const ReadResult r = read_all(*reader);
+        ADD_FAILURE() << "read " << r.events.size() << " events without an error";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_EQ(e.unit(), InputError::Unit::byte);
+        EXPECT_NE(what.find("AEChip"), std::string::npos) << what;
+        EXPECT_NE(what.find("--chip"), std::string::npos) << what;
+        EXPECT_NE(what.find(words), std::string::npos) << what;
+    }
+}
+
+TEST(Aedat2Chip, Davis240cRecordingLabelledDvs128IsAnErrorNotThreeEvents) {
+    EVCORNER_REQUIRE_SHARED_DATA();
+    TempDir tmp;
+    const auto path = tmp.write("boxes.aedat", with_chip_line(read_bytes(davis_path("IMU_translBoxes")),
+                                                              "ch.unizh.ini.jaer.chip.retina.DVS128"));
+    expect_chip_error(path, {}, "--size");
+    io::ReaderOptions skip;  // skipping invalid events does not hide it either
+    skip.skip_invalid = true;
+    expect_chip_error(path, skip, "outside the 128x128 sensor");
+
+    // Naming the camera, or a size only a DAVIS layout can address, reads every event.
+    const Figures& fig = kDavis240Files.at("IMU_translBoxes");
+    io::ReaderOptions chip;
+    chip.aedat2_chip = "DAVIS240C";
+    io::ReaderOptions size;
+    size.sensor = SensorSize{240, 180};
+    for (const auto& o : {chip, size}) {
+        auto reader = io::open_event_reader(path, o);
+        EXPECT_EQ(*reader->sensor(), (SensorSize{240, 180}));
+        const ReadResult r = read_all(*reader);
+        ASSERT_FALSE(r.failed) << r.error;
+        expect_figures(r.events, fig, "IMU_translBoxes relabelled DVS128");
+    }
+}
+
+TEST(Aedat2Chip, Dvs128RecordingLabelledDavisIsAnError) {
+    EVCORNER_REQUIRE_SHARED_DATA();
+    TempDir tmp;
+    const auto original = (shared_data() / "real/dvs128-walking-ouyang/neal_walking.aedat").string();
+    const auto path = tmp.write("walk.aedat", with_chip_line(read_bytes(original), "eu.seebetter.ini.chips.davis.DAVIS240C"));
+    expect_chip_error(path, {}, "DVS128");
+    io::ReaderOptions o;
+    o.aedat2_chip = "dvs128";
+    auto reader = io::open_event_reader(path, o);
+    const ReadResult r = read_all(*reader);
+    ASSERT_FALSE(r.failed) << r.error;
+    expect_figures(r.events, kDvs128Files.at("neal_walking"), "neal_walking relabelled DAVIS240C");
+}
+
+TEST(Aedat2Chip, CraftedMismatchesAndTheThreshold) {
+    TempDir tmp;
+    // 100 DAVIS240C events labelled DVS128: every address has bits above 15.
+    std::string davis_as_dvs = kDvs128Header;
+    for (int i = 0; i < 100; ++i) record(davis_as_dvs, davis(100 + i % 100, 50 + i % 100, i % 2), 10 + i);
+    expect_chip_error(tmp.write("a.aedat", davis_as_dvs), {}, "100 of the first 100 address words");
+
+    // DAVIS346 events on a DAVIS240C header, skipped as invalid: still an error.
+    std::string big = kDavisHeader;
+    for (int i = 0; i < 100; ++i) record(big, davis(300, 200, true), 10 + i);
+    io::ReaderOptions skip;
+    skip.skip_invalid = true;
+    expect_chip_error(tmp.write("b.aedat", big), skip, "outside the 240x180 sensor");
+    io::ReaderOptions chip346 = skip;
+    chip346.aedat2_chip = "DAVIS346";
+    auto r346 = io::open_event_reader(tmp.path("b.aedat"), chip346);
+    EXPECT_EQ(read_all(*r346).events.size(), 100u);
+
+    // Half the words off the sensor is not "most": those are skipped (or errors) one by one.
+    std::string half = kDavisHeader;
+    for (int i = 0; i < 50; ++i) {
+        record(half, davis(10, 10, true), 10 + 2 * i);
+        record(half, davis(300, 10, true), 11 + 2 * i);
+    }
+    auto rh = io::open_event_reader(tmp.write("h.aedat", half), skip);
+    const ReadResult h = read_all(*rh);
+    ASSERT_FALSE(h.failed) << h.error;
+    EXPECT_EQ(h.events.size(), 50u);
+    EXPECT_EQ(h.skipped, 50u);
+
+    // APS and IMU words (bit 31) are not address words: a DAVIS file that starts with a
+    // frame is judged on its DVS events.
+    std::string aps = kDavisHeader;
+    for (int i = 0; i < 1000; ++i) record(aps, 0x8000'0000u | davis(i % 240, i % 180, false), 5);
+    record(aps, davis(1, 2, true), 6);
+    auto ra = io::open_event_reader(tmp.write("p.aedat", aps));
+    EXPECT_EQ(read_all(*ra).events.size(), 1u);
+
+    // DVS128 words on a DAVIS header: at least 64 of them are needed to call it.
+    std::string dvs_as_davis = kDavisHeader;
+    for (int i = 0; i < 63; ++i) record(dvs_as_davis, (5u << 8) | (9u << 1), 10 + i);
+    auto r63 = io::open_event_reader(tmp.write("d63.aedat", dvs_as_davis));
+    EXPECT_FALSE(read_all(*r63).failed);
+    record(dvs_as_davis, (5u << 8) | (9u << 1), 100);
+    expect_chip_error(tmp.write("d64.aedat", dvs_as_davis), {}, "DVS128");
+}
+
+TEST(Aedat2Chip, ChipOptionIsChecked) {
+    TempDir tmp;
+    std::string f = kDavisHeader;
+    record(f, davis(1, 1, true), 1);
+    const auto path = tmp.write("a.aedat", f);
+    io::ReaderOptions o;
+    o.aedat2_chip = "DAVIS999";
+    EXPECT_THROW(io::open_event_reader(path, o), std::invalid_argument);
+    EXPECT_TRUE(Aedat2Reader::known_chip("DAVIS240C"));
+    EXPECT_TRUE(Aedat2Reader::known_chip("ch.unizh.ini.jaer.chip.retina.DVS128"));
+    EXPECT_FALSE(Aedat2Reader::known_chip("DAVIS"));
+    // A chip names an AEDAT 2.0 layout: on any other format it is a usage error.
+    o.aedat2_chip = "DAVIS240C";
+    EXPECT_THROW(io::open_event_reader(tmp.write("e.txt", "0.1 1 1 1\n"), o), std::invalid_argument);
+    // No AEChip line at all: --chip makes it readable.
+    std::string none = "#!AER-DAT2.0\r\n";
+    record(none, davis(3, 4, true), 1);
+    EXPECT_THROW(io::open_event_reader(tmp.write("n.aedat", none)), InputError);
+    auto r = io::open_event_reader(tmp.path("n.aedat"), o);
+    const std::vector<Event> want = {{1, 3, 4, 1}};
+    EXPECT_EQ(read_all(*r).events, want);
 }
 
 }  // namespace

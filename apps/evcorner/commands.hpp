@@ -14,8 +14,9 @@ void add_eval_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 
-/// The input-format options that info and convert share (--format, --csv-columns, --time-unit).
-void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit);
+/// The input-format options every command shares (--format, --csv-columns, --time-unit, --chip).
+void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit,
+                       std::string& chip);
 /// --to: the output format (detect, convert); an unknown name is a usage error.
 void add_output_format_option(CLI::App& cmd, std::string& to);
 

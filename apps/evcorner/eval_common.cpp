@@ -14,6 +14,7 @@ LoadedEvents load_events(const std::string& path, const InputOptions& o) {
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
+    ropts.aedat2_chip = o.chip;
     const auto reader = io::open_event_reader(path, ropts, o.format);
     LoadedEvents out;
     out.events = io::read_all_events(*reader);
@@ -22,7 +23,7 @@ LoadedEvents load_events(const std::string& path, const InputOptions& o) {
 }
 
 void add_load_options(CLI::App& cmd, InputOptions& o) {
-    add_input_options(cmd, o.format, o.csv_columns, o.time_unit);
+    add_input_options(cmd, o.format, o.csv_columns, o.time_unit, o.chip);
     cmd.add_option("--size", o.size, "Sensor size WxH [default: the file's own, else 240x180]")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";

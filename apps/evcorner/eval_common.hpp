@@ -19,6 +19,7 @@ struct InputOptions {
     std::string csv_columns;
     std::string time_unit = "us";
     std::string size;  ///< WxH, empty: the file's own, else 240x180
+    std::string chip;  ///< AEDAT 2.0 camera, empty: the header's "# AEChip"
 };
 
 struct LoadedEvents {
@@ -29,7 +30,7 @@ struct LoadedEvents {
 /// Reads every event of `path` into memory (the evaluation needs random access).
 LoadedEvents load_events(const std::string& path, const InputOptions& o);
 
-/// Adds --format, --csv-columns, --time-unit and --size.
+/// Adds --format, --csv-columns, --time-unit, --chip and --size.
 void add_load_options(CLI::App& cmd, InputOptions& o);
 
 /// The feature-track parameters as options (--ft-*); `overlap` receives the name.

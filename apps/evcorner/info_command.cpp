@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "evcorner/error.hpp"
+#include "evcorner/io/aedat2_reader.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
@@ -32,6 +33,7 @@ struct InfoOptions {
     std::string size;
     std::string csv_columns;
     std::string time_unit = "us";
+    std::string chip;
     std::string json;
     bool skip_invalid = false;
     bool no_progress = false;
@@ -89,6 +91,7 @@ void run_info(const InfoOptions& o) {
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
+    ropts.aedat2_chip = o.chip;
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
     // With the JSON on standard output, the table goes to standard error.
     std::FILE* human = o.json == "-" ? stderr : stdout;
@@ -168,7 +171,8 @@ void run_info(const InfoOptions& o) {
 
 }  // namespace
 
-void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit) {
+void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit,
+                       std::string& chip) {
     cmd.add_option("--format", format,
                    "Input format: auto (from the content), " + std::string(io::kInputFormats))
         ->capture_default_str()
@@ -183,6 +187,14 @@ void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_colu
     cmd.add_option("--time-unit", time_unit, "CSV time unit: us, ns, ms or s")
         ->capture_default_str()
         ->check(CLI::IsMember({"us", "ns", "ms", "s"}));
+    cmd.add_option("--chip", chip,
+                   "AEDAT 2.0: the camera that recorded the file (DVS128, DAVIS240C, DAVIS346, ...), "
+                   "instead of the header's '# AEChip' line")
+        ->check([](const std::string& s) {
+            return io::Aedat2Reader::known_chip(s)
+                       ? std::string()
+                       : "unknown chip (known: DVS128, DAVIS128, DAVIS208, DAVIS240A/B/C, DAVIS346, DAVIS640)";
+        });
 }
 
 void add_info_command(CLI::App& app) {
@@ -196,7 +208,7 @@ void add_info_command(CLI::App& app) {
         "cut from the first event, the remainder under 1 ms joined to the last bin (a span\n"
         "under 1 ms is one bin), in events per second of the bin's length: never below the mean.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
-    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit);
+    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";

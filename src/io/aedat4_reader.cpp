@@ -88,8 +88,8 @@ std::vector<Aedat4Stream> parse_streams(std::string_view xml) {
 
 }  // namespace
 
-Aedat4Reader::Aedat4Reader(std::string path, ReaderOptions options, std::optional<int> stream_id)
-    : BinaryReader(std::move(path), options) {
+Aedat4Reader::Aedat4Reader(InputFile file, ReaderOptions options, std::optional<int> stream_id)
+    : BinaryReader(std::move(file), std::move(options)) {
     const std::size_t m = kAedat4Magic.size();
     if (fill(m) < m || std::memcmp(data(), kAedat4Magic.data(), m) != 0)
         fail(0, "not an AEDAT 4.0 file (it must start with '#!AER-DAT4.0\\r\\n')");

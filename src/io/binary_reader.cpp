@@ -13,8 +13,8 @@ constexpr std::size_t kBufferSize = 1 << 20;
 constexpr std::size_t kMaxHeaderLine = 1 << 16;
 }  // namespace
 
-BinaryReader::BinaryReader(std::string path, ReaderOptions options)
-    : file_(std::move(path)), options_(options), buf_(kBufferSize) {
+BinaryReader::BinaryReader(InputFile file, ReaderOptions options)
+    : file_(std::move(file)), options_(std::move(options)), buf_(kBufferSize) {
     set_file_sensor(std::nullopt);
 }
 
@@ -51,10 +51,14 @@ std::size_t BinaryReader::fill(std::size_t want) {
 
 bool BinaryReader::header_line(char marker, std::string& line) {
     if (fill(1) == 0 || buf_[pos_] != marker) return false;
+    const std::uint64_t start = offset();
     line.clear();
     for (;;) {
         const std::size_t avail = fill(1);
-        if (avail == 0) return true;  // a header with no data after it
+        if (avail == 0)
+            fail(offset(), fmt::format("the file ends inside the header line that starts at byte {}: "
+                                       "it is cut short",
+                                       start));
         const char* b = buf_.data() + pos_;
         const void* nl = std::memchr(b, '\n', avail);
         const std::size_t len = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - b) : avail;

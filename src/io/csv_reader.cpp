@@ -28,8 +28,8 @@ std::string lower_trim(std::string_view s) {
 
 }  // namespace
 
-CsvReader::CsvReader(std::string path, ReaderOptions options)
-    : lines_(std::move(path)), options_(std::move(options)) {
+CsvReader::CsvReader(InputFile file, ReaderOptions options)
+    : lines_(std::move(file)), options_(std::move(options)) {
     sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
     const std::string& u = options_.csv_time_unit;
     if (u == "us") time_digits_ = 0;

@@ -11,7 +11,8 @@ namespace {
 constexpr std::size_t kRecord = 8;
 }  // namespace
 
-DatReader::DatReader(std::string path, ReaderOptions options) : BinaryReader(std::move(path), options) {
+DatReader::DatReader(InputFile file, ReaderOptions options)
+    : BinaryReader(std::move(file), std::move(options)) {
     PropheseeHeader h;
     std::string line;
     while (!h.ended && header_line('%', line)) h.add_line(line);

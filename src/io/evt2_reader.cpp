@@ -11,12 +11,18 @@ namespace {
 constexpr std::size_t kWord = 4;
 }  // namespace
 
-Evt2Reader::Evt2Reader(std::string path, ReaderOptions options) : BinaryReader(std::move(path), options) {
+Evt2Reader::Evt2Reader(InputFile file, ReaderOptions options)
+    : BinaryReader(std::move(file), std::move(options)) {
     PropheseeHeader h;
     std::string line;
     while (!h.ended && header_line('%', line)) h.add_line(line);
     if (!h.evt.empty() && h.evt != "2.0")
         fail(0, fmt::format("the header says EVT {}, not EVT 2.0", h.evt));
+    // Without "% end" the header's end is where the data starts: no data at all is a
+    // file cut short at the end of a header line.
+    if (!h.ended && fill(1) == 0)
+        fail(offset(), offset() == 0 ? "the file is empty"
+                                     : "the file ends right after its header, with no event data: it is cut short");
     set_address_limit(2048);
     set_file_sensor(h.sensor());
 }

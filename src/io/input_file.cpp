@@ -7,34 +7,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 #include "evcorner/error.hpp"
 
 namespace evcorner::io {
-
-namespace {
-// Bytes peeked from standard input and not yet handed to a reader.
-std::string& stdin_stash() {
-    static std::string stash;
-    return stash;
-}
-std::size_t& stdin_stash_pos() {
-    static std::size_t pos = 0;
-    return pos;
-}
-}  // namespace
-
-std::string_view peek_stdin(std::size_t max_bytes) {
-    std::string& stash = stdin_stash();
-    while (stash.size() < max_bytes) {
-        char buf[4096];
-        const ssize_t n = ::read(STDIN_FILENO, buf, std::min(sizeof buf, max_bytes - stash.size()));
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;
-        stash.append(buf, static_cast<std::size_t>(n));
-    }
-    return std::string_view(stash).substr(stdin_stash_pos());
-}
 
 InputFile::InputFile(std::string path) {
     if (path == "-") {
@@ -59,28 +36,67 @@ InputFile::InputFile(std::string path) {
 #endif
 }
 
+InputFile::InputFile(InputFile&& other) noexcept
+    : name_(std::move(other.name_)),
+      fd_(std::exchange(other.fd_, -1)),
+      owns_fd_(std::exchange(other.owns_fd_, false)),
+      size_(other.size_),
+      consumed_(other.consumed_),
+      ahead_(std::move(other.ahead_)),
+      ahead_pos_(std::exchange(other.ahead_pos_, 0)),
+      eof_(other.eof_) {}
+
 InputFile::~InputFile() {
     if (owns_fd_) ::close(fd_);
 }
 
+std::size_t InputFile::read_fd(char* buf, std::size_t n) {
+    if (eof_) return 0;
+    for (;;) {
+        const ssize_t got = ::read(fd_, buf, n);
+        if (got > 0) return static_cast<std::size_t>(got);
+        if (got == 0) {
+            eof_ = true;
+            return 0;
+        }
+        if (errno == EINTR) continue;
+        throw InputError(name_, InputError::Unit::byte, consumed_ + (ahead_.size() - ahead_pos_),
+                         std::string("read failed: ") + std::strerror(errno));
+    }
+}
+
+std::string_view InputFile::peek(std::size_t n) {
+    if (ahead_pos_ > 0) {
+        ahead_.erase(0, ahead_pos_);
+        ahead_pos_ = 0;
+    }
+    while (ahead_.size() < n && !eof_) {
+        // Ask for a little more than needed from a file (fewer calls); a pipe returns
+        // what it holds without waiting for the rest.
+        const std::size_t want = std::max<std::size_t>(n - ahead_.size(), 4096);
+        const std::size_t old = ahead_.size();
+        ahead_.resize(old + want);
+        const std::size_t got = read_fd(ahead_.data() + old, want);
+        ahead_.resize(old + got);
+    }
+    return ahead_;
+}
+
 std::size_t InputFile::read(std::span<char> buf) {
-    if (fd_ == STDIN_FILENO && stdin_stash_pos() < stdin_stash().size()) {
-        const std::size_t n = std::min(buf.size(), stdin_stash().size() - stdin_stash_pos());
-        std::memcpy(buf.data(), stdin_stash().data() + stdin_stash_pos(), n);
-        stdin_stash_pos() += n;
+    if (ahead_pos_ < ahead_.size()) {
+        const std::size_t n = std::min(buf.size(), ahead_.size() - ahead_pos_);
+        std::memcpy(buf.data(), ahead_.data() + ahead_pos_, n);
+        ahead_pos_ += n;
+        if (ahead_pos_ == ahead_.size()) {
+            std::string().swap(ahead_);
+            ahead_pos_ = 0;
+        }
         consumed_ += n;
         return n;
     }
-    for (;;) {
-        const ssize_t n = ::read(fd_, buf.data(), buf.size());
-        if (n >= 0) {
-            consumed_ += static_cast<std::uint64_t>(n);
-            return static_cast<std::size_t>(n);
-        }
-        if (errno == EINTR) continue;
-        throw InputError(name_, InputError::Unit::byte, consumed_,
-                         std::string("read failed: ") + std::strerror(errno));
-    }
+    const std::size_t n = read_fd(buf.data(), buf.size());
+    consumed_ += n;
+    return n;
 }
 
 }  // namespace evcorner::io

@@ -68,7 +68,8 @@ void NpyWriter::close() {
     closed_ = true;
 }
 
-NpyReader::NpyReader(std::string path, ReaderOptions options) : BinaryReader(std::move(path), options) {
+NpyReader::NpyReader(InputFile file, ReaderOptions options)
+    : BinaryReader(std::move(file), std::move(options)) {
     if (fill(10) < 10 || std::memcmp(data(), kMagic, 6) != 0) fail(0, "not a .npy file (no \\x93NUMPY magic)");
     const int major = data()[6];
     std::size_t len = 0;

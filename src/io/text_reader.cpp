@@ -84,8 +84,8 @@ Parsed parse_line(const char* p, const char* end) {
 
 }  // namespace
 
-TextReader::TextReader(std::string path, ReaderOptions options)
-    : lines_(std::move(path)), options_(options) {}
+TextReader::TextReader(InputFile file, ReaderOptions options)
+    : lines_(std::move(file)), options_(std::move(options)) {}
 
 std::size_t TextReader::read(std::span<Event> out) {
     skips_.new_batch();

@@ -11,8 +11,20 @@
 //     (external events) is skipped.
 // Coordinates are returned as stored (jAER displays them mirrored; no flip is applied).
 // The 32-bit timestamp wraps every 71.6 minutes; the wrap is unrolled into int64.
+//
+// ReaderOptions::aedat2_chip names the camera instead of the header (a wrong or missing
+// "# AEChip" line); ReaderOptions::sensor overrides the size, and a size above 128x128
+// means the DAVIS layout whatever the header says. Unless the chip is given, the header's
+// chip is checked against the data before any event is returned: when more than half of
+// the first 4096 address words (DVS and special events; APS and IMU samples do not count)
+// within the first 131 072 records (1 MiB) decode outside the sensor (for DVS128: have any
+// of bits 16..31 set), or, for a DAVIS chip, more than half of at least 64 of them have
+// only their low 16 bits set (DVS128 words), the constructor throws an InputError that
+// says so and names --chip and --size. A header with no record after it is a file cut
+// short.
 
 #include <string>
+#include <string_view>
 
 #include "evcorner/io/binary_reader.hpp"
 
@@ -22,10 +34,17 @@ class Aedat2Reader final : public BinaryReader {
 public:
     enum class Layout { davis, dvs128 };
 
+    /// Reads `file` from its first unread byte and parses its header. Throws InputError.
+    explicit Aedat2Reader(InputFile file, ReaderOptions options = {});
     /// Opens `path` and parses its header. Throws InputError.
-    explicit Aedat2Reader(std::string path, ReaderOptions options = {});
+    explicit Aedat2Reader(std::string path, ReaderOptions options = {})
+        : Aedat2Reader(InputFile(std::move(path)), std::move(options)) {}
 
     [[nodiscard]] std::string_view format() const noexcept override { return "aedat2"; }
+    /// Whether `name` names a camera this reader knows (as in "# AEChip:" and aedat2_chip:
+    /// DVS128, DAVIS128, DAVIS208, DAVIS240A/B/C, DAVIS346, DAVIS640, or jAER class names
+    /// that contain them; case-insensitive).
+    [[nodiscard]] static bool known_chip(std::string_view name);
     /// The "# AEChip:" header value ("" when absent).
     [[nodiscard]] const std::string& chip() const noexcept { return chip_; }
     [[nodiscard]] Layout layout() const noexcept { return layout_; }
@@ -34,6 +53,7 @@ public:
 
 private:
     bool decode() override;
+    void check_layout();
 
     std::string chip_;
     Layout layout_ = Layout::davis;

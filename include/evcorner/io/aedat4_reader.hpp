@@ -47,10 +47,15 @@ public:
     /// Largest packet accepted, compressed or decompressed.
     static constexpr std::size_t kMaxPacketBytes = std::size_t{64} << 20;
 
-    /// Opens `path` and parses its IOHeader; decodes event stream `stream_id` (nullopt:
-    /// the first "EVTS" stream of the description). Throws InputError.
-    explicit Aedat4Reader(std::string path, ReaderOptions options = {},
+    /// Reads `file` from its first unread byte and parses its IOHeader; decodes event
+    /// stream `stream_id` (nullopt: the first "EVTS" stream of the description). Reads
+    /// front to back only, so a pipe works. Throws InputError.
+    explicit Aedat4Reader(InputFile file, ReaderOptions options = {},
                           std::optional<int> stream_id = std::nullopt);
+    /// Opens `path` and reads it as above. Throws InputError.
+    explicit Aedat4Reader(std::string path, ReaderOptions options = {},
+                          std::optional<int> stream_id = std::nullopt)
+        : Aedat4Reader(InputFile(std::move(path)), std::move(options), stream_id) {}
     ~Aedat4Reader() override;
     Aedat4Reader(const Aedat4Reader&) = delete;
     Aedat4Reader& operator=(const Aedat4Reader&) = delete;

@@ -15,6 +15,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "evcorner/error.hpp"
@@ -58,7 +59,8 @@ public:
     [[nodiscard]] std::uint64_t events() const noexcept { return events_; }
 
 protected:
-    BinaryReader(std::string path, ReaderOptions options);
+    /// Reads `file` from its first unread byte, which is byte offset 0 in messages.
+    BinaryReader(InputFile file, ReaderOptions options);
 
     /// Decodes events into the batch with push() until batch_full() or the end of the
     /// data; returns false at the end. Throws (fail()) on bad input.
@@ -88,7 +90,8 @@ protected:
 
     /// Reads one header line if the next byte is `marker`: the line without its line
     /// break (and '\r'). Returns false (consuming nothing) when the next byte is not
-    /// `marker` or at the end of the file.
+    /// `marker` or at the end of the file. A file that ends before the line's break is
+    /// cut short: an error at its end.
     bool header_line(char marker, std::string& line);
 
     // -- the events

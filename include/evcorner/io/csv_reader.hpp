@@ -20,8 +20,11 @@ namespace evcorner::io {
 
 class CsvReader final : public EventReader {
 public:
+    /// Reads `file` from its first unread byte. Throws InputError (also for bad options).
+    explicit CsvReader(InputFile file, ReaderOptions options = {});
     /// Opens `path` ("-" = standard input). Throws InputError (also for bad options).
-    explicit CsvReader(std::string path, ReaderOptions options = {});
+    explicit CsvReader(std::string path, ReaderOptions options = {})
+        : CsvReader(InputFile(std::move(path)), std::move(options)) {}
 
     std::size_t read(std::span<Event> out) override;
     [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }

@@ -16,8 +16,11 @@ namespace evcorner::io {
 
 class DatReader final : public BinaryReader {
 public:
+    /// Reads `file` from its first unread byte and parses its header. Throws InputError.
+    explicit DatReader(InputFile file, ReaderOptions options = {});
     /// Opens `path` and parses its header. Throws InputError.
-    explicit DatReader(std::string path, ReaderOptions options = {});
+    explicit DatReader(std::string path, ReaderOptions options = {})
+        : DatReader(InputFile(std::move(path)), std::move(options)) {}
 
     [[nodiscard]] std::string_view format() const noexcept override { return "dat"; }
     [[nodiscard]] int event_type() const noexcept { return event_type_; }

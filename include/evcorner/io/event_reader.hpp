@@ -33,6 +33,10 @@ struct ReaderOptions {
     /// names allowed, "_" ignores a column), e.g. "x,y,p,t". Empty: from the file's
     /// header row when it has one, else "t,x,y,p".
     std::string csv_columns;
+    /// AEDAT 2.0 only: the camera that recorded the file, as a jAER chip name ("DVS128",
+    /// "DAVIS240C", "DAVIS346", ...; see aedat2_reader.hpp), used instead of the header's
+    /// "# AEChip:" line for the address layout and the sensor size. Empty: the header's.
+    std::string aedat2_chip;
     /// CSV only: the unit of the t column: "us" (integers), "ns", "ms" or "s" (decimals).
     std::string csv_time_unit = "us";
 };

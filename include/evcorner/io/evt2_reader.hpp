@@ -16,8 +16,11 @@ namespace evcorner::io {
 
 class Evt2Reader final : public BinaryReader {
 public:
+    /// Reads `file` from its first unread byte and parses its header. Throws InputError.
+    explicit Evt2Reader(InputFile file, ReaderOptions options = {});
     /// Opens `path` and parses its header. Throws InputError.
-    explicit Evt2Reader(std::string path, ReaderOptions options = {});
+    explicit Evt2Reader(std::string path, ReaderOptions options = {})
+        : Evt2Reader(InputFile(std::move(path)), std::move(options)) {}
 
     [[nodiscard]] std::string_view format() const noexcept override { return "evt2"; }
     /// Words of other types (triggers, OTHERS, unknown) skipped so far.

@@ -23,8 +23,11 @@ namespace evcorner::io {
 
 class Evt3Reader final : public BinaryReader {
 public:
+    /// Reads `file` from its first unread byte and parses its header. Throws InputError.
+    explicit Evt3Reader(InputFile file, ReaderOptions options = {});
     /// Opens `path` and parses its header. Throws InputError.
-    explicit Evt3Reader(std::string path, ReaderOptions options = {});
+    explicit Evt3Reader(std::string path, ReaderOptions options = {})
+        : Evt3Reader(InputFile(std::move(path)), std::move(options)) {}
 
     [[nodiscard]] std::string_view format() const noexcept override { return "evt3"; }
     /// Words of other types (triggers, OTHERS, continued, unknown) skipped so far.

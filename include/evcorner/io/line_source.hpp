@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "evcorner/io/input_file.hpp"
@@ -16,10 +17,13 @@ namespace evcorner::io {
 
 class LineSource {
 public:
-    /// Opens `path` ("-" = standard input). Throws InputError. A line longer than
+    /// Reads the lines of `file` (from its first unread byte). A line longer than
     /// `buffer_bytes` is an error.
+    explicit LineSource(InputFile file, std::size_t buffer_bytes = std::size_t{1} << 20)
+        : file_(std::move(file)), buf_(buffer_bytes) {}
+    /// Opens `path` ("-" = standard input). Throws InputError.
     explicit LineSource(std::string path, std::size_t buffer_bytes = std::size_t{1} << 20)
-        : file_(std::move(path)), buf_(buffer_bytes) {}
+        : LineSource(InputFile(std::move(path)), buffer_bytes) {}
 
     /// The next line as [begin, end); false at the end of the input. Throws InputError.
     bool next(const char*& begin, const char*& end) {

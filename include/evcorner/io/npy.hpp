@@ -36,7 +36,11 @@ private:
 /// Reads event .npy files. No sensor metadata: ReaderOptions::fallback_sensor applies.
 class NpyReader final : public BinaryReader {
 public:
-    explicit NpyReader(std::string path, ReaderOptions options = {});
+    /// Reads `file` from its first unread byte and parses its header. Throws InputError.
+    explicit NpyReader(InputFile file, ReaderOptions options = {});
+    /// Opens `path` and parses its header. Throws InputError.
+    explicit NpyReader(std::string path, ReaderOptions options = {})
+        : NpyReader(InputFile(std::move(path)), std::move(options)) {}
     [[nodiscard]] std::string_view format() const noexcept override { return "npy"; }
     /// The array length the header declares.
     [[nodiscard]] std::uint64_t declared_events() const noexcept { return declared_; }

@@ -1,31 +1,43 @@
 #pragma once
 // Opening an event file of any supported format: the format is told by the content
-// (magic bytes, header), or forced by name.
+// (magic bytes, header), or forced by name. The input is opened once: the bytes the
+// format is told from are peeked at and then read by the reader, so pipes, FIFOs and
+// process substitutions (`<(...)`) work like files.
 
 #include <memory>
 #include <string>
 #include <string_view>
 
 #include "evcorner/io/event_reader.hpp"
+#include "evcorner/io/input_file.hpp"
 
 namespace evcorner::io {
 
 /// The format names open_event_reader() accepts, besides "auto".
 inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat, hdf5";
 
-/// Tells the format of `path` from its first bytes: "aedat2" ("#!AER-DAT2.0"), "aedat4"
-/// ("#!AER-DAT4.0\r\n"), "hdf5" (the HDF5 signature at byte 0), "npy",
-/// "evt2" / "evt3" (a Prophesee '%' header with "% evt 2.0|3.0" or "% format EVT2|EVT3"),
-/// "dat" ("% Data file containing ..."), "csv" (the first non-comment line has a
-/// comma), else "ecd-text". Throws InputError for a
-/// Prophesee header that names no supported encoding. Standard input ("-") is always
-/// "ecd-text" unless forced.
+/// Tells the format of `file` from its first bytes, which it only peeks at
+/// (InputFile::peek), so a reader given `file` afterwards reads them too: "aedat2"
+/// ("#!AER-DAT2.0"), "aedat4" ("#!AER-DAT4.0\r\n"), "hdf5" (the HDF5 signature at byte 0),
+/// "npy", "evt2" / "evt3" (a Prophesee '%' header with "% evt 2.0|3.0" or
+/// "% format EVT2|EVT3"), "dat" ("% Data file containing ..."), "csv" (the first
+/// non-comment line has a comma), else "ecd-text" (an empty input too). Looks at no more
+/// than the header needs (at most 64 KiB), so a pipe is not waited on for more.
+/// Throws InputError for a Prophesee header that names no supported encoding, and for an
+/// input that ends inside a signature or a '%' header (cut short).
+std::string detect_format(InputFile& file);
+
+/// detect_format() of the file at `path`, opened for the purpose. What it reads from a
+/// pipe is gone afterwards: use open_event_reader() to read one.
 std::string detect_format(const std::string& path);
 
 /// Opens `path` ("-" = standard input) with the reader of `format` ("auto": detect).
 /// Formats without sensor metadata (text, files whose header has no geometry) validate
 /// against options.sensor, else options.fallback_sensor (the DAVIS240C's 240x180
-/// unless changed). Throws InputError.
+/// unless changed). HDF5 needs a regular file (the HDF5 library seeks and opens the
+/// path itself); every other format reads front to back and works on a pipe.
+/// Throws InputError; std::invalid_argument for options.aedat2_chip on a file that is
+/// not AEDAT 2.0.
 std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOptions options = {},
                                                std::string_view format = "auto");
 

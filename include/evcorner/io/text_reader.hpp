@@ -26,8 +26,11 @@ namespace evcorner::io {
 /// When options.sensor is set, an event outside it is an error (or skipped).
 class TextReader final : public EventReader {
 public:
+    /// Reads `file` from its first unread byte. Throws InputError.
+    explicit TextReader(InputFile file, ReaderOptions options = {});
     /// Opens `path` ("-" = standard input). Throws InputError.
-    explicit TextReader(std::string path, ReaderOptions options = {});
+    explicit TextReader(std::string path, ReaderOptions options = {})
+        : TextReader(InputFile(std::move(path)), std::move(options)) {}
 
     /// Fills `out` with the next events; returns how many (0 at the end).
     /// Throws InputError on bad input. Events parsed before a bad line are
