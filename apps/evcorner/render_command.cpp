@@ -303,7 +303,14 @@ std::string detector_text(const RenderOptions& o) {
     return "detector " + o.detector;
 }
 
+// A PNG goes to a file named *.png, or to a device or pipe that already exists (/dev/null,
+// a FIFO): those have no name to mislead.
 void check_output_name(const std::string& path) {
+    std::error_code ec;
+    const auto st = std::filesystem::status(path, ec);
+    if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) &&
+        !std::filesystem::is_directory(st))
+        return;
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     if (ext != ".png")
@@ -441,7 +448,7 @@ void add_render_command(CLI::App& app) {
         "draws the figure alone. The input is streamed: memory follows the window drawn, not\n"
         "the length of the input.");
     cmd->add_option("INPUT", o->input, "Event file (any format evcorner reads)")->required();
-    cmd->add_option("-o,--output", o->output, "PNG file to write (the name must end in .png)")->required();
+    cmd->add_option("-o,--output", o->output, "PNG file to write (the name must end in .png, or be an existing device or FIFO)")->required();
     cmd->add_option("-k,--kind", o->kind, "sae, corners, space-time or labels")
         ->capture_default_str()
         ->check(CLI::IsMember({"sae", "corners", "space-time", "labels"}));
