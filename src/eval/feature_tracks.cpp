@@ -316,7 +316,8 @@ const Kernels& chosen_kernels() noexcept {
     return c;
 }
 
-FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParams& p, const Kernels& kern) {
+FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParams& p, const Kernels& kern,
+                         const LabelProgress& progress = {}) {
     validate(p);
     if (corners.size() >= std::numeric_limits<std::uint32_t>::max())
         throw std::invalid_argument("feature tracks: at most 2^32 - 2 corner events");
@@ -344,6 +345,7 @@ FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParam
     std::vector<std::uint32_t> cursor(ix.bucket_begin.begin(), ix.bucket_begin.end() - 1);
     std::size_t lo = 0;
     for (std::size_t a = 0; a < n; ++a) {
+        if (progress && a % 4096 == 0) progress(a, n);
         if (exclusive && claimed[a]) continue;
         const std::int64_t ta = ix.t[a];
         const std::int64_t t_end = ta + p.max_duration_us;
@@ -473,6 +475,7 @@ FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParam
         result.on_track[ix.original[i]] = on_track[i];
         result.labelled += on_track[i];
     }
+    if (progress) progress(n, n);
     return result;
 }
 
@@ -480,6 +483,11 @@ FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParam
 
 FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& p) {
     return label(corners, p, chosen_kernels());
+}
+
+FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& p,
+                                        const LabelProgress& progress) {
+    return label(corners, p, chosen_kernels(), progress);
 }
 
 const char* feature_track_code_path() noexcept { return chosen_kernels().name; }

@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -75,6 +76,13 @@ struct FeatureTrackResult {
 /// partner's cylinders over the corners on the partner's side of the anchor (quadrant
 /// lists, docs/evaluation.md) with SIMD loops chosen for the CPU at run time.
 FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& params = {});
+
+/// Told now and then (every few thousand anchors, and at the end) how many corner events
+/// have been anchors so far, of all: for a progress bar.
+using LabelProgress = std::function<void(std::size_t done, std::size_t total)>;
+/// label_feature_tracks() reporting its progress.
+FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& params,
+                                        const LabelProgress& progress);
 
 /// The code path label_feature_tracks() takes: "avx512", "avx2" or "portable" (the
 /// environment variable EVCORNER_LABEL_PATH forces one this CPU runs). Every path gives
