@@ -90,40 +90,50 @@ bool has_event_extension(const fs::path& p) {
     return std::find(event_extensions().begin(), event_extensions().end(), ext) != event_extensions().end();
 }
 
-// Makes every name unique: names shared by several inputs take the file's extension (when
-// named after the stem), then their parent folders, one at a time, and at last a number.
+// Makes every name unique. Inputs of one name that are different files take, all alike,
+// the fewest of these that tells them apart: level 0 the name; for a file named after its
+// stem, level 1 its file name with the extension; then one parent folder more per level.
+// The same file given twice keeps its name, with "#2", "#3" ... after the first.
 void make_names_unique(std::vector<Sequence>& seqs) {
-    auto clashing = [&](std::size_t i) {
-        for (std::size_t k = 0; k < seqs.size(); ++k)
-            if (k != i && seqs[k].name == seqs[i].name) return true;
-        return false;
-    };
     std::vector<fs::path> abs;
     for (const auto& s : seqs) abs.push_back(fs::absolute(s.file).lexically_normal());
-    // Step 0: file name with extension for stem-named inputs; step k >= 1: k parent folders.
-    for (int step = 0; step <= 64; ++step) {
-        std::vector<std::size_t> clash;
-        for (std::size_t i = 0; i < seqs.size(); ++i)
-            if (clashing(i)) clash.push_back(i);
-        if (clash.empty()) return;
-        for (const std::size_t i : clash) {
-            const bool events_txt = abs[i].filename() == "events.txt";
-            fs::path dir = abs[i].parent_path();
-            if (events_txt) dir = dir.parent_path();  // the sequence folder is the name already
-            std::string name = events_txt ? seqs[i].base : abs[i].filename().string();
-            if (step == 0 && !events_txt) {
-                seqs[i].name = name;
-                continue;
+    auto level = [&](std::size_t i, int k) {
+        const bool events_txt = abs[i].filename() == "events.txt";
+        if (k == 0) return seqs[i].name;
+        fs::path dir = abs[i].parent_path();
+        std::string name = seqs[i].name;
+        if (events_txt) {
+            dir = dir.parent_path();  // the sequence folder is the name already
+        } else {
+            name = abs[i].filename().string();
+            --k;
+        }
+        for (; k > 0 && dir.has_relative_path(); --k, dir = dir.parent_path()) name = dir.filename().string() + "/" + name;
+        return name;
+    };
+    std::map<std::string, std::vector<std::size_t>> groups;
+    for (std::size_t i = 0; i < seqs.size(); ++i) groups[seqs[i].name].push_back(i);
+    std::vector<std::string> names(seqs.size());
+    for (const auto& [name, members] : groups) {
+        for (int k = 0;; ++k) {
+            std::map<std::string, fs::path> file_of;
+            bool apart = true;
+            for (const std::size_t i : members) {
+                const auto [it, added] = file_of.emplace(level(i, k), abs[i]);
+                if (!added && it->second != abs[i]) apart = false;
             }
-            for (int k = 0; k < step && dir.has_filename(); ++k, dir = dir.parent_path())
-                name = dir.filename().string() + "/" + name;
-            seqs[i].name = name;
+            // Different files in one folder tree always part within their path's length.
+            if (apart || k > 256) {
+                for (const std::size_t i : members) names[i] = level(i, k);
+                break;
+            }
         }
     }
-    // The same file twice: a number after the name, in input order.
     std::map<std::string, int> seen;
-    for (auto& s : seqs)
-        if (++seen[s.name] > 1) s.name += "#" + std::to_string(seen[s.name]);
+    for (std::size_t i = 0; i < seqs.size(); ++i) {
+        seqs[i].name = names[i];
+        if (++seen[names[i]] > 1) seqs[i].name += "#" + std::to_string(seen[names[i]]);
+    }
 }
 
 std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
