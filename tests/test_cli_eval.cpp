@@ -152,6 +152,13 @@ TEST_F(CliEval, InputsOfOneNameStayApart) {
     for (const char* n : {"| a/shapes_translation | 91.7 |", "| b/shapes_translation | 91.7 |",
                           "| a/shapes_translation#2 | 91.7 |"})
         EXPECT_NE(md.find(n), std::string::npos) << n << "\n" << md;
+    // A name whose figure stem meets another's ("a/x.txt" and "a_x.txt", named apart from
+    // "a_x.npy") keeps its figures apart.
+    fs::copy_file(sample_, dir_ / "a_x.txt");
+    ASSERT_EQ(run_status("convert a_x.txt a_x.npy", &err), 0) << err;
+    ASSERT_EQ(run_status("eval a/x.txt b/x.txt a_x.txt a_x.npy -d efast --repeat 1 -q --report rep2", &err), 0) << err;
+    EXPECT_GT(png_size(dir_ / "rep2/figures/a_x.txt.sae.png").first, 0u);
+    EXPECT_GT(png_size(dir_ / "rep2/figures/a_x.txt#2.sae.png").first, 0u);
 }
 
 // Issue 15 item 22: a folder of event files (not the dataset's layout) was refused with

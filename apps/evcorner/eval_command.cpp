@@ -58,6 +58,7 @@ struct Sequence {
     std::string name;  ///< unique among the inputs: rows, figures and CSV lines
     std::string base;  ///< the dataset's sequence name (folder of events.txt, else stem): the paper's rows
     fs::path file;
+    std::string stem;  ///< the name as a file-name stem for the figures, unique too
 };
 
 // The paper's Table 1 (Red., FT in %): spatially-adaptive Harris, then eFAST.
@@ -74,6 +75,12 @@ const std::map<std::string, PaperRow>& paper_table1() {
         {"boxes_translation", {92.4, 37.0, 96.7, 30.5}},   {"boxes_6dof", {92.7, 34.4, 96.8, 26.7}},
     };
     return t;
+}
+
+// A sequence's name as a file-name stem: the folders that make it unique joined by '_'.
+std::string file_stem(std::string name) {
+    std::replace(name.begin(), name.end(), '/', '_');
+    return name;
 }
 
 // The extensions of the event files evcorner reads (case-insensitive); a folder given as
@@ -143,7 +150,7 @@ std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
         if (fs::is_directory(p)) {
             if (fs::is_regular_file(p / "events.txt")) {
                 const std::string name = fs::absolute(p).lexically_normal().filename().string();
-                seqs.push_back({name, name, p / "events.txt"});
+                seqs.push_back({name, name, p / "events.txt", {}});
                 continue;
             }
             // <sequence>/events.txt folders (the dataset's layout) and event files.
@@ -166,17 +173,23 @@ std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
             }
             for (const auto& f : skipped)
                 fmt::print(stderr, "eval: {}: skipped, not an event file by its extension\n", f.string());
-            for (const auto& d : dirs) seqs.push_back({d.filename().string(), d.filename().string(), d / "events.txt"});
-            for (const auto& f : files) seqs.push_back({f.stem().string(), f.stem().string(), f});
+            for (const auto& d : dirs) seqs.push_back({d.filename().string(), d.filename().string(), d / "events.txt", {}});
+            for (const auto& f : files) seqs.push_back({f.stem().string(), f.stem().string(), f, {}});
         } else {
             // events.txt in a sequence folder takes the folder's name, other files their stem.
             const std::string name = p.filename() == "events.txt" && p.has_parent_path()
                                          ? fs::absolute(p).parent_path().filename().string()
                                          : p.stem().string();
-            seqs.push_back({name, name, p});
+            seqs.push_back({name, name, p, {}});
         }
     }
     make_names_unique(seqs);
+    // Figure stems: the name's folders joined by '_'; one that meets another name's gets a number.
+    std::set<std::string> stems;
+    for (auto& q : seqs) {
+        q.stem = file_stem(q.name);
+        for (int k = 2; !stems.insert(q.stem).second; ++k) q.stem = file_stem(q.name) + "#" + std::to_string(k);
+    }
     return seqs;
 }
 
@@ -273,12 +286,6 @@ std::vector<std::string> split_detectors(const std::string& list) {
     }
     if (out.empty()) throw std::invalid_argument("-d: no detector named");
     return out;
-}
-
-// A sequence's name as a file-name stem: the folders that make it unique joined by '_'.
-std::string file_stem(std::string name) {
-    std::replace(name.begin(), name.end(), '/', '_');
-    return name;
 }
 
 std::string cell(double v) { return std::isnan(v) ? "-" : fmt::format("{:.1f}", v); }
@@ -457,7 +464,7 @@ void run_eval(EvalOptions& o) {
                              {"label_s", label_s}});
             if (figs && !figs->empty()) {
                 const std::int64_t t_first = figs->first_t(), t_last = figs->last_t();
-                const std::string stem = file_stem(seq.name) + "." + k.name;
+                const std::string stem = seq.stem + "." + k.name;
                 render::write_png((fig_dir / (stem + ".corners.png")).string(),
                                   render::upscale(render::render_recent_corners(figs->newest(false), corners, size, t_last), 2));
                 render::write_png((fig_dir / (stem + ".labels.png")).string(),
@@ -470,11 +477,11 @@ void run_eval(EvalOptions& o) {
         }
         if (figs && !figs->empty()) {
             const std::int64_t t_first = figs->first_t(), t_last = figs->last_t();
-            render::write_png((fig_dir / (file_stem(seq.name) + ".sae.png")).string(),
+            render::write_png((fig_dir / (seq.stem + ".sae.png")).string(),
                               render::upscale(render::render_sae(figs->newest(true), size, 1, t_last,
                                                                  std::max<std::int64_t>(1, t_last - t_first)),
                                               2));
-            render::write_png((fig_dir / (file_stem(seq.name) + ".space_time.png")).string(),
+            render::write_png((fig_dir / (seq.stem + ".space_time.png")).string(),
                               render::render_space_time(figs->sample(), kinds.front().corners, {}, size, t_first,
                                                         std::max(t_last, t_first + 1)));
         }
