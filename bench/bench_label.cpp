@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "evcorner/detector.hpp"
@@ -86,10 +87,10 @@ std::vector<Event> real_replayed() {
     return out;
 }
 
-void run(benchmark::State& state, const std::vector<Event>& corners) {
+void run(benchmark::State& state, const std::vector<Event>& corners, const std::string& path = {}) {
     eval::FeatureTrackResult r;
     for (auto _ : state) {
-        r = eval::label_feature_tracks(corners);
+        r = path.empty() ? eval::label_feature_tracks(corners) : eval::label_feature_tracks_on_path(path, corners);
         benchmark::DoNotOptimize(r.on_track.data());
     }
     state.counters["corners"] = static_cast<double>(corners.size());
@@ -108,6 +109,17 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark("label/ecd_efast_replayed_100k", [](benchmark::State& s) { run(s, real); })
         ->Unit(benchmark::kMillisecond)
         ->Iterations(1);
+    // Each code path this CPU runs (the unsuffixed ones above take the fastest).
+    for (const std::string& path : eval::feature_track_code_paths()) {
+        benchmark::RegisterBenchmark(("label/synthetic_100k/" + path).c_str(),
+                                     [path](benchmark::State& s) { run(s, syn, path); })
+            ->Unit(benchmark::kMillisecond)
+            ->Iterations(1);
+        benchmark::RegisterBenchmark(("label/ecd_efast_replayed_100k/" + path).c_str(),
+                                     [path](benchmark::State& s) { run(s, real, path); })
+            ->Unit(benchmark::kMillisecond)
+            ->Iterations(1);
+    }
     benchmark::Initialize(&argc, argv);
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();

@@ -2,12 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
 #include "cli_test_util.hpp"
+#include "evcorner/io/text_reader.hpp"
 
 namespace evcorner {
 namespace {
@@ -105,6 +109,134 @@ TEST_F(CliEval, RenderEveryKindAsPng) {
     EXPECT_NE(run_status("render '" + sample_.string() + "' -k nonsense -o x.png", &err), 0);
     EXPECT_NE(run_status("render no-such-file.txt -o x.png", &err), 0);
     EXPECT_NE(err.find("no-such-file.txt"), std::string::npos) << err;
+}
+
+
+// The rows of table1.csv: sequence -> "detector,events,corners,on_track,..." lines.
+std::vector<std::string> csv_rows(const std::string& csv) {
+    std::vector<std::string> rows;
+    std::istringstream in(csv);
+    std::string line;
+    std::getline(in, line);  // header
+    while (std::getline(in, line)) rows.push_back(line);
+    return rows;
+}
+
+// Issue 15 item 8: inputs with one name were one Table 1 row, their figures overwrote each
+// other and their CSV rows could not be told apart.
+TEST_F(CliEval, InputsOfOneNameStayApart) {
+    for (const char* d : {"a/shapes_translation", "b/shapes_translation"}) {
+        fs::create_directories(dir_ / d);
+        fs::copy_file(sample_, dir_ / d / "events.txt");
+    }
+    fs::copy_file(sample_, dir_ / "a/x.txt");
+    fs::copy_file(sample_, dir_ / "b/x.txt");
+    std::string err;
+    ASSERT_EQ(run_status("eval a/shapes_translation/events.txt b/shapes_translation a/shapes_translation/events.txt "
+                         "a/x.txt b/x.txt -d efast --repeat 1 -q --report rep",
+                         &err),
+              0)
+        << err;
+    const auto rows = csv_rows(slurp(dir_ / "rep/table1.csv"));
+    ASSERT_EQ(rows.size(), 5u) << slurp(dir_ / "rep/table1.csv");
+    const char* names[] = {"a/shapes_translation", "b/shapes_translation", "a/shapes_translation#2", "a/x.txt",
+                           "b/x.txt"};
+    for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(rows[i].substr(0, rows[i].find(',')), names[i]) << rows[i];
+    // One figure set per input, none overwritten; the paper's row for every shapes_translation.
+    for (const char* stem : {"a_shapes_translation", "b_shapes_translation", "a_shapes_translation#2", "a_x.txt",
+                             "b_x.txt"}) {
+        EXPECT_GT(png_size(dir_ / "rep/figures" / (std::string(stem) + ".efast.labels.png")).first, 0u) << stem;
+        EXPECT_GT(png_size(dir_ / "rep/figures" / (std::string(stem) + ".sae.png")).first, 0u) << stem;
+    }
+    const std::string md = slurp(dir_ / "rep/report.md");
+    for (const char* n : {"| a/shapes_translation | 91.7 |", "| b/shapes_translation | 91.7 |",
+                          "| a/shapes_translation#2 | 91.7 |"})
+        EXPECT_NE(md.find(n), std::string::npos) << n << "\n" << md;
+    // A name whose figure stem meets another's ("a/x.txt" and "a_x.txt", named apart from
+    // "a_x.npy") keeps its figures apart.
+    fs::copy_file(sample_, dir_ / "a_x.txt");
+    ASSERT_EQ(run_status("convert a_x.txt a_x.npy", &err), 0) << err;
+    ASSERT_EQ(run_status("eval a/x.txt b/x.txt a_x.txt a_x.npy -d efast --repeat 1 -q --report rep2", &err), 0) << err;
+    EXPECT_GT(png_size(dir_ / "rep2/figures/a_x.txt.sae.png").first, 0u);
+    EXPECT_GT(png_size(dir_ / "rep2/figures/a_x.txt#2.sae.png").first, 0u);
+}
+
+// Issue 15 item 22: a folder of event files (not the dataset's layout) was refused with
+// exit 2; report.md had an empty comparison with the paper for sequences not in it.
+TEST_F(CliEval, FolderOfEventFilesAndNoPaperRows) {
+    fs::create_directories(dir_ / "rec");
+    fs::copy_file(sample_, dir_ / "rec/one.txt");
+    ASSERT_EQ(run_status("convert '" + sample_.string() + "' rec/two.npy"), 0);
+    ASSERT_EQ(run_status("convert '" + sample_.string() + "' rec/three.aedat4"), 0);
+    write("rec/README.md", "not events\n");
+    std::string err;
+    ASSERT_EQ(run_status("eval rec -d efast --repeat 1 --report rep --no-figures", &err), 0) << err;
+    EXPECT_NE(err.find("README.md: skipped"), std::string::npos) << err;
+    const auto rows = csv_rows(slurp(dir_ / "rep/table1.csv"));
+    ASSERT_EQ(rows.size(), 3u);
+    // Sorted by file name; the same events in three formats give the same row.
+    const std::string tail = rows[0].substr(rows[0].find(','));
+    EXPECT_EQ(rows[0], "one" + tail);
+    EXPECT_EQ(rows[1], "three" + tail);
+    EXPECT_EQ(rows[2], "two" + tail);
+    const std::string md = slurp(dir_ / "rep/report.md");
+    EXPECT_EQ(md.find("(paper)"), std::string::npos) << md;
+    EXPECT_NE(md.find("nothing to set beside it"), std::string::npos) << md;
+    // A folder with no event file at all is still a usage error, naming it.
+    fs::create_directories(dir_ / "empty");
+    write("empty/notes.md", "x\n");
+    EXPECT_EQ(run_status("eval empty -q", &err), 2);
+    EXPECT_NE(err.find("empty: no <sequence>/events.txt folder and no event file"), std::string::npos) << err;
+}
+
+// Issue 15 item 9: label --json - mixed the summary into the JSON on standard output.
+TEST_F(CliEval, LabelJsonOnStandardOutputParses) {
+    ASSERT_EQ(run_status("detect '" + sample_.string() + "' -q -o corners.txt"), 0);
+    ASSERT_EQ(run_status("label corners.txt -o labels.txt"), 0);
+    const std::string labels = slurp(dir_ / "labels.txt");
+    const auto ones = static_cast<std::size_t>(std::count(labels.begin(), labels.end(), '1'));
+    const test::CliResult r = run("label corners.txt --json -");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);  // throws when not pure JSON
+    EXPECT_EQ(j.at("on_track").get<std::size_t>(), ones);
+    EXPECT_NE(r.err.find("FT "), std::string::npos) << r.err;
+    // Labels and JSON cannot share standard output.
+    EXPECT_EQ(run_status("label corners.txt -o - --json -"), 2);
+}
+
+// Streaming: eval reads the input batch by batch (65 536 events). On a stream of several
+// batches its corners and FT are those of detect (a streaming command) and label, for
+// every detector, and each of the --repeat runs has its own time.
+TEST_F(CliEval, StreamedEvalAgreesWithDetectAndLabel) {
+    const std::vector<Event> events = io::read_text_file(sample_.string());
+    ASSERT_FALSE(events.empty());
+    std::string text;
+    std::int64_t offset = 0;
+    for (int copy = 0; copy < 5; ++copy) {  // 150 000 events, copies 1 ms apart
+        const std::int64_t shift = offset - events.front().t;
+        for (const Event& e : events) {
+            const std::int64_t t = e.t + shift;
+            text += fmt::format("{}.{:06d} {} {} {}\n", t / 1'000'000, t % 1'000'000, e.x, e.y, int(e.p));
+        }
+        offset = events.back().t + shift + 1000;
+    }
+    write("long.txt", text);
+    std::string err;
+    ASSERT_EQ(run_status("eval long.txt -d efast,harris --repeat 2 -q --report rep", &err), 0) << err;
+    const nlohmann::json res = nlohmann::json::parse(slurp(dir_ / "rep/results.json"));
+    ASSERT_EQ(res.at("runs").size(), 2u);
+    for (const auto& run : res.at("runs")) {
+        const std::string d = run.at("detector");
+        ASSERT_EQ(run_status("detect long.txt -d " + d + " -q -o c-" + d + ".txt", &err), 0) << err;
+        ASSERT_EQ(run_status("label c-" + d + ".txt --json l-" + d + ".json", &err), 0) << err;
+        const nlohmann::json l = nlohmann::json::parse(slurp(dir_ / ("l-" + d + ".json")));
+        EXPECT_EQ(run.at("events").get<std::size_t>(), 150'000u) << d;
+        EXPECT_EQ(run.at("corners").get<std::size_t>(), test::count_lines(slurp(dir_ / ("c-" + d + ".txt")))) << d;
+        EXPECT_EQ(run.at("on_track"), l.at("on_track")) << d;
+        EXPECT_EQ(run.at("hypotheses"), l.at("hypotheses")) << d;
+        EXPECT_EQ(run.at("detect_s_runs").size(), 2u) << d;
+        for (const auto& s : run.at("detect_s_runs")) EXPECT_GT(s.get<double>(), 0.0) << d;
+    }
 }
 
 }  // namespace

@@ -6,11 +6,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <random>
 #include <stdexcept>
 #include <vector>
 
 #include "evcorner/eval/feature_tracks.hpp"
+#include "feature_tracks_reference.hpp"
+#include "evcorner/io/text_reader.hpp"
+
+#include <filesystem>
+#include <string>
 
 namespace evcorner::eval {
 namespace {
@@ -219,6 +225,100 @@ TEST(FeatureTracks, EmptyInputAndBadParameters) {
     EXPECT_THROW(validate(p), std::invalid_argument);
     EXPECT_THROW(parse_track_overlap("some"), std::invalid_argument);
     EXPECT_EQ(parse_track_overlap("exclusive"), TrackOverlap::exclusive);
+}
+
+
+// The labeller against the implementation it replaced (tests/feature_tracks_reference.hpp):
+// the same labels and the same hypothesis and acceptance counts, on every code path this
+// CPU runs, for both overlap modes, per polarity or not, on streams with tracks crossing
+// each other, clutter near them (so hypotheses leave the tracks), ties in time, and
+// corners at the sensor's edges.
+void expect_same_as_reference(const std::vector<Event>& corners, const FeatureTrackParams& p, const std::string& what) {
+    const FeatureTrackResult ref = label_feature_tracks_reference(corners, p);
+    for (const std::string& path : feature_track_code_paths()) {
+        const FeatureTrackResult r = label_feature_tracks_on_path(path, corners, p);
+        EXPECT_EQ(r.on_track, ref.on_track) << what << " on " << path;
+        EXPECT_EQ(r.labelled, ref.labelled) << what << " on " << path;
+        EXPECT_EQ(r.hypotheses, ref.hypotheses) << what << " on " << path;
+        EXPECT_EQ(r.accepted, ref.accepted) << what << " on " << path;
+    }
+}
+
+std::vector<Event> busy_stream(unsigned seed) {
+    std::mt19937 rng(seed);
+    Stream s;
+    std::uniform_real_distribution<double> px(0, 239), py(0, 179), v(-1.0, 1.0);
+    std::uniform_int_distribution<int> count(20, 70), step(200, 1500), pol(0, 1);
+    for (int k = 0; k < 25; ++k) {
+        const Track tr{px(rng), py(rng), v(rng), v(rng), static_cast<std::int64_t>(k) * 7000, count(rng),
+                       static_cast<std::int64_t>(step(rng))};
+        Stream t;
+        add_track(t, tr, 1, rng, 1, pol(rng));
+        for (Event e : t.corners) {
+            e.x = static_cast<std::uint16_t>(std::min<int>(e.x, 239));
+            e.y = static_cast<std::uint16_t>(std::min<int>(e.y, 179));
+            s.corners.push_back(e);
+        }
+    }
+    // Clutter anywhere, also beside the tracks, and exact time ties.
+    std::uniform_int_distribution<int> x(0, 239), y(0, 179);
+    std::uniform_int_distribution<std::int64_t> t(0, 250'000);
+    for (int k = 0; k < 1500; ++k) s.corners.push_back(at(x(rng), y(rng), t(rng), pol(rng)));
+    for (int k = 0; k < 200; ++k) {
+        Event e = s.corners[static_cast<std::size_t>(k) * 7 % s.corners.size()];
+        e.x = static_cast<std::uint16_t>(std::min(239, e.x + 2));
+        s.corners.push_back(e);  // same time as another corner, 2 px away
+    }
+    std::shuffle(s.corners.begin(), s.corners.end(), rng);
+    return s.corners;
+}
+
+TEST(FeatureTracks, SameAsTheReferenceOnEveryCodePath) {
+    ASSERT_FALSE(feature_track_code_paths().empty());
+    EXPECT_EQ(std::string(feature_track_code_path()), feature_track_code_paths().front());
+    EXPECT_THROW(label_feature_tracks_on_path("no-such-path", {}), std::invalid_argument);
+    for (unsigned seed = 1; seed <= 4; ++seed) {
+        const std::vector<Event> corners = busy_stream(seed);
+        FeatureTrackParams p;
+        const FeatureTrackResult ref = label_feature_tracks_reference(corners, p);
+        EXPECT_GT(ref.accepted, 0u) << "tracks to find";
+        EXPECT_LT(ref.labelled, corners.size()) << "clutter to reject";
+        expect_same_as_reference(corners, p, "defaults, seed " + std::to_string(seed));
+        p.overlap = TrackOverlap::exclusive;
+        expect_same_as_reference(corners, p, "exclusive, seed " + std::to_string(seed));
+        p = {};
+        p.same_polarity = true;
+        p.min_inner = 10;
+        expect_same_as_reference(corners, p, "per polarity, 10 inner, seed " + std::to_string(seed));
+        p = {};
+        p.inner_radius = 2.5;
+        p.outer_radius = 6.5;  // a margin that is not a whole number
+        p.max_length = 33;
+        p.max_outer_ratio = 0.5;
+        p.min_inner = 12;
+        p.cell_size = 5;
+        expect_same_as_reference(corners, p, "other radii, seed " + std::to_string(seed));
+    }
+}
+
+TEST(FeatureTracks, SameAsTheReferenceOnRealCorners) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::path(EVCORNER_SHARED_DIR) / "data/real/ecd-stppp";
+    const fs::path golden = fs::path(EVCORNER_SHARED_DIR) / "data/golden";
+    if (!fs::is_directory(dir)) GTEST_SKIP() << "no " << dir << " (the shared data folder)";
+    for (const std::string seq : {"shapes_rotation", "shapes_translation", "dynamic_translation"}) {
+        for (const std::string det : {"efast", "harris"}) {
+            const std::vector<Event> events = io::read_text_file((dir / seq / "events.txt").string());
+            std::vector<Event> corners;
+            std::ifstream idx(golden / ("ecd-stppp." + seq + "." + det + ".idx"));
+            for (std::size_t i; idx >> i;) corners.push_back(events.at(i));
+            ASSERT_FALSE(corners.empty()) << seq << " " << det;
+            FeatureTrackParams p;
+            expect_same_as_reference(corners, p, seq + " " + det);
+            p.overlap = TrackOverlap::exclusive;
+            expect_same_as_reference(corners, p, seq + " " + det + " exclusive");
+        }
+    }
 }
 
 }  // namespace

@@ -6,19 +6,42 @@
 #include "commands.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/io/open.hpp"
+#include "progress.hpp"
 
 namespace evcorner::cli {
 
-LoadedEvents load_events(const std::string& path, const InputOptions& o) {
+std::unique_ptr<io::EventReader> open_events(const std::string& path, const InputOptions& o) {
     io::ReaderOptions ropts;
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
     ropts.aedat2_chip = o.chip;
-    const auto reader = io::open_event_reader(path, ropts, o.format);
+    return io::open_event_reader(path, ropts, o.format);
+}
+
+SensorSize sensor_of(const io::EventReader& reader) { return reader.sensor().value_or(kDavis240); }
+
+LoadedEvents load_events(const std::string& path, const InputOptions& o) {
+    const auto reader = open_events(path, o);
     LoadedEvents out;
     out.events = io::read_all_events(*reader);
-    out.size = reader->sensor().value_or(kDavis240);
+    out.size = sensor_of(*reader);
+    return out;
+}
+
+LoadedEvents load_events(const std::string& path, const InputOptions& o, bool progress) {
+    const auto reader = open_events(path, o);
+    Progress bar(progress, reader->bytes_total());
+    LoadedEvents out;
+    std::vector<Event> batch(std::size_t{1} << 16);
+    for (;;) {
+        const std::size_t n = reader->read(batch);
+        if (n == 0 && reader->skipped_in_batch().empty()) break;
+        out.events.insert(out.events.end(), batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(n));
+        bar.update(reader->bytes_consumed(), out.events.size());
+    }
+    bar.finish();
+    out.size = sensor_of(*reader);
     return out;
 }
 

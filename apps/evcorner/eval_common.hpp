@@ -1,15 +1,17 @@
 #pragma once
-// What label, eval and render share: loading a whole event file, running a detector
-// over it, parsing a time option, and the feature-track options.
+// What label, eval and render share: opening or loading an event file, running a
+// detector over it, parsing a time option, and the feature-track options.
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "evcorner/any_detector.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/event.hpp"
+#include "evcorner/io/event_reader.hpp"
 #include "evcorner/sensor.hpp"
 
 namespace evcorner::cli {
@@ -29,6 +31,15 @@ struct LoadedEvents {
 
 /// Reads every event of `path` into memory (the evaluation needs random access).
 LoadedEvents load_events(const std::string& path, const InputOptions& o);
+
+/// Opens `path` for reading batch by batch, with the same options as load_events.
+std::unique_ptr<io::EventReader> open_events(const std::string& path, const InputOptions& o);
+
+/// load_events with a progress bar on standard error (when it is a terminal and `progress`).
+LoadedEvents load_events(const std::string& path, const InputOptions& o, bool progress);
+
+/// The sensor events of `reader` are on: its own, else 240x180.
+SensorSize sensor_of(const io::EventReader& reader);
 
 /// Adds --format, --csv-columns, --time-unit, --chip and --size.
 void add_load_options(CLI::App& cmd, InputOptions& o);

@@ -8,12 +8,14 @@
 #include <fmt/format.h>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 
 #include "commands.hpp"
 #include "eval_common.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/io/output_file.hpp"
+#include "progress.hpp"
 
 namespace evcorner::cli {
 
@@ -23,6 +25,7 @@ struct LabelOptions {
     std::string input;
     std::string output;
     std::string json;
+    bool no_progress = false;
     InputOptions in;
     eval::FeatureTrackParams params;
     std::string overlap = "any";
@@ -30,9 +33,17 @@ struct LabelOptions {
 
 void run_label(LabelOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
-    const LoadedEvents corners = load_events(o.input, o.in);
+    if (o.output == "-" && o.json == "-")
+        throw std::invalid_argument("-o - and --json - would both write to standard output; send one to a file");
+    // Progress bars on standard error while reading and while labelling (terminal only).
+    const LoadedEvents corners = load_events(o.input, o.in, !o.no_progress);
     const auto t0 = std::chrono::steady_clock::now();
-    const eval::FeatureTrackResult r = eval::label_feature_tracks(corners.events, o.params);
+    eval::FeatureTrackResult r;
+    {
+        Progress bar(!o.no_progress, corners.events.size());
+        r = eval::label_feature_tracks(corners.events, o.params,
+                                       [&](std::size_t done, std::size_t) { bar.update(done, done); });
+    }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!o.output.empty()) {
         io::OutputFile out(o.output);
@@ -45,7 +56,9 @@ void run_label(LabelOptions& o) {
         out.write(text);
         out.close();
     }
-    std::FILE* summary = o.output == "-" ? stderr : stdout;
+    // Standard output carries the labels or the JSON when either goes there; the
+    // human summary then goes to standard error.
+    std::FILE* summary = o.output == "-" || o.json == "-" ? stderr : stdout;
     fmt::print(summary, "FT {:.2f} % ({} of {} corner events on feature tracks)\n", r.ft_percent(), r.labelled,
                r.on_track.size());
     fmt::print(summary, "  {} hypotheses tried, {} accepted, {:.3f} s\n", r.hypotheses, r.accepted, secs);
@@ -76,7 +89,9 @@ void add_label_command(CLI::App& app) {
         "events on tracks. Input: corner events of any detector in any format evcorner reads.");
     cmd->add_option("CORNERS", o->input, "Corner-event file, or - for standard input")->required();
     cmd->add_option("-o,--output", o->output, "Write one line per corner event: 1 on a track, 0 not (- = stdout)");
-    cmd->add_option("--json", o->json, "Also write the figures as JSON to this file");
+    cmd->add_option("--json", o->json,
+                    "Also write the figures as JSON to this file (- = stdout; the summary then goes to stderr)");
+    cmd->add_flag("--no-progress", o->no_progress, "No progress bar (shown only when stderr is a terminal)");
     add_load_options(*cmd, o->in);
     add_feature_track_options(*cmd, o->params, o->overlap);
     cmd->footer(

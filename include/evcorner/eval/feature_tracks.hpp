@@ -14,7 +14,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -70,7 +72,27 @@ struct FeatureTrackResult {
 
 /// Labels every corner event of `corners` (any order; time order is not required).
 /// Cost: a bucket index over (x, y) with time-sorted buckets; each anchor gathers only
-/// the corners inside its reachable space-time box, never all corners.
+/// the corners inside its reachable space-time box, never all corners, and counts a
+/// partner's cylinders over the corners on the partner's side of the anchor (quadrant
+/// lists, docs/evaluation.md) with SIMD loops chosen for the CPU at run time.
 FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& params = {});
+
+/// Told now and then (every few thousand anchors, and at the end) how many corner events
+/// have been anchors so far, of all: for a progress bar.
+using LabelProgress = std::function<void(std::size_t done, std::size_t total)>;
+/// label_feature_tracks() reporting its progress.
+FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& params,
+                                        const LabelProgress& progress);
+
+/// The code path label_feature_tracks() takes: "avx512", "avx2" or "portable" (the
+/// environment variable EVCORNER_LABEL_PATH forces one this CPU runs). Every path gives
+/// the same result.
+const char* feature_track_code_path() noexcept;
+/// Every code path this CPU runs, fastest first.
+std::vector<std::string> feature_track_code_paths();
+/// label_feature_tracks() on a named path (one of feature_track_code_paths(); else
+/// std::invalid_argument).
+FeatureTrackResult label_feature_tracks_on_path(std::string_view path, std::span<const Event> corners,
+                                                const FeatureTrackParams& params = {});
 
 }  // namespace evcorner::eval
