@@ -113,6 +113,26 @@ TEST_F(CliOutputs, ABinaryRecordingIsNotConvertedOntoItself) {
     }
 }
 
+TEST_F(CliOutputs, LabelEvalAndRenderRefuseOutputsOntoTheirInputs) {
+    const std::string same = copy_sample("same.txt");
+    const std::string png = copy_sample("same.png");  // event text under a PNG name
+    fs::create_directory(dir_ / "rep");
+    fs::copy_file(sample_, dir_ / "rep" / "table1.csv");
+    const std::string before = slurp(same);
+    for (const std::string args :
+         {"label same.txt -o same.txt", "label same.txt -o l.txt --json same.txt", "render same.png -o same.png",
+          "render same.txt --corners same.png -o same.png", "eval rep/table1.csv --report rep -q --repeat 1"}) {
+        SCOPED_TRACE(args);
+        const Result r = run(args);
+        EXPECT_EQ(r.status, 2) << r.err;
+        EXPECT_NE(r.err.find("is the input"), std::string::npos) << r.err;
+        EXPECT_EQ(slurp(same), before);
+        EXPECT_EQ(slurp(png), before);
+        EXPECT_EQ(slurp(dir_ / "rep" / "table1.csv"), before);
+        EXPECT_EQ(files(), (std::vector<std::string>{"rep", "same.png", "same.txt"}));
+    }
+}
+
 // ---------------------------------------------------------------- 2: render to a device
 
 TEST_F(CliOutputs, RenderToAFullDeviceFailsAndRemovesNothing) {

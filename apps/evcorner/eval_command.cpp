@@ -30,6 +30,7 @@
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/eval/metrics.hpp"
 #include "evcorner/io/output_file.hpp"
+#include "evcorner/io/output_paths.hpp"
 #include "evcorner/render/figures.hpp"
 #include "progress.hpp"
 
@@ -391,6 +392,12 @@ void run_eval(EvalOptions& o) {
     const std::vector<Sequence> seqs = find_sequences(o.inputs);
     fs::path fig_dir;
     if (!o.report.empty()) {
+        // The report's files must not land on an input (--report pointing into the data).
+        std::vector<io::NamedPath> inputs, outputs;
+        for (const Sequence& seq : seqs) inputs.push_back({"INPUTS", seq.file.string()});
+        for (const char* name : {"table1.csv", "table2.csv", "results.json", "report.md"})
+            outputs.push_back({"--report", (fs::path(o.report) / name).string()});
+        io::check_output_paths(inputs, outputs);
         fs::create_directories(o.report);
         if (!o.no_figures) fs::create_directories(fig_dir = fs::path(o.report) / "figures");
     }

@@ -15,6 +15,7 @@
 #include "eval_common.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/io/output_file.hpp"
+#include "evcorner/io/output_paths.hpp"
 #include "progress.hpp"
 
 namespace evcorner::cli {
@@ -35,6 +36,7 @@ void run_label(LabelOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
     if (o.output == "-" && o.json == "-")
         throw std::invalid_argument("-o - and --json - would both write to standard output; send one to a file");
+    io::check_output_paths({{"CORNERS", o.input}}, {{"-o", o.output}, {"--json", o.json}});
     // Progress bars on standard error while reading and while labelling (terminal only).
     const LoadedEvents corners = load_events(o.input, o.in, !o.no_progress);
     const auto t0 = std::chrono::steady_clock::now();

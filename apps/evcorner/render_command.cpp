@@ -31,6 +31,7 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/error.hpp"
 #include "evcorner/io/open.hpp"
+#include "evcorner/io/output_paths.hpp"
 #include "evcorner/render/figures.hpp"
 #include "evcorner/render/frame.hpp"
 #include "progress.hpp"
@@ -320,6 +321,7 @@ void check_output_name(const std::string& path) {
 void run_render(RenderOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
     check_output_name(o.output);
+    io::check_output_paths({{"INPUT", o.input}, {"--corners", o.corners_file}}, {{"-o", o.output}});
     if (!o.at.empty()) (void)parse_time_option(o.at, 0, 0);  // its syntax, before reading anything
     const Need need = need_for(o);
     const bool from_file = !o.corners_file.empty();
