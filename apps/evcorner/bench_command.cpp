@@ -474,7 +474,7 @@ void run_bench(const BenchOptions& o) {
         std::vector<Event> stream;
         std::uint64_t file_events = 0;
         {
-            LoadedEvents file = load_events(input, o.in);
+            LoadedEvents file = load_events(input, o.in, !o.quiet && !o.no_progress);  // its own bar while reading
             sensor = file.size;
             file_events = file.events.size();
             stream = replay(file.events, o.min_events);
