@@ -72,7 +72,7 @@ const Path& choice() noexcept {
 
 std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
     detail::check_flags(events.size(), is_corner.size(), "detect");
-    check_events(events, det.limits());
+    check_events(events, det.limits());  // one pass over the batch, before the first event
     return choice().loop(det, events, is_corner);
 }
 
