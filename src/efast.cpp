@@ -15,7 +15,7 @@ namespace evcorner {
 namespace {
 
 std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-    return det.run<ScalarSearch>(events, is_corner);
+    return det.run_unchecked<ScalarSearch>(events, is_corner);
 }
 
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
@@ -23,11 +23,11 @@ std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span
 // AVX2 here and nowhere else (no AVX2 copy of a shared inline function can leak).
 [[gnu::target("avx2"), gnu::flatten]] std::size_t detect_avx2(EFast& det, std::span<const Event> events,
                                                                std::span<std::uint8_t> is_corner) noexcept {
-    return det.run<Avx2Search>(events, is_corner);
+    return det.run_unchecked<Avx2Search>(events, is_corner);
 }
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t detect_avx512(
     EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-    return det.run<Avx512Search>(events, is_corner);
+    return det.run_unchecked<Avx512Search>(events, is_corner);
 }
 #endif
 
@@ -70,7 +70,13 @@ const Path& choice() noexcept {
 
 }  // namespace
 
-std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
+    detail::check_flags(events.size(), is_corner.size(), "detect");
+    check_events(events, det.limits());  // one pass over the batch, before the first event
+    return choice().loop(det, events, is_corner);
+}
+
+std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
     return choice().loop(det, events, is_corner);
 }
 
@@ -85,7 +91,11 @@ std::vector<std::string> efast_code_paths() {
 std::size_t detect_on_path(std::string_view path, EFast& det, std::span<const Event> events,
                            std::span<std::uint8_t> is_corner) {
     for (const Path& p : paths())
-        if (path == p.name) return p.loop(det, events, is_corner);
+        if (path == p.name) {
+            detail::check_flags(events.size(), is_corner.size(), "detect_on_path");
+            check_events(events, det.limits());
+            return p.loop(det, events, is_corner);
+        }
     throw std::invalid_argument("eFAST code path '" + std::string(path) + "' does not run on this CPU");
 }
 

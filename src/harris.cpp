@@ -26,11 +26,11 @@ HarrisParams validated(HarrisParams p) {
 Harris::Harris(SensorSize size, HarrisParams params, int planes)
     : params_(validated(params)),
       scorer_(params_.window, params_.k),
-      sae_(size, params_.window / 2, planes),
+      sae_(checked_sensor_size(size, "Harris"), params_.window / 2, planes),
       radius_(params_.window / 2) {}
 
-bool Harris::process(const Event& e) noexcept {
-    sae_.update(e);
+bool Harris::process_unchecked(const Event& e) noexcept {
+    sae_.update_unchecked(e);
     score_ = kNoScore;
     const SensorSize s = sae_.size();
     // The reference's border rule: '>' on the far side, so the window of an event at

@@ -22,16 +22,16 @@ HarrisGlobalParams validated(HarrisGlobalParams p) {
 HarrisGlobal::HarrisGlobal(SensorSize size, HarrisGlobalParams params)
     : params_(validated(params)),
       scorer_(params_.window, params_.k),
-      sae_(size, params_.window / 2),
+      sae_(checked_sensor_size(size, "Harris-global"), params_.window / 2),
       newest_{NewestPixels(static_cast<std::size_t>(params_.n), static_cast<std::size_t>(size.pixels())),
               NewestPixels(static_cast<std::size_t>(params_.n), static_cast<std::size_t>(size.pixels()))},
       radius_(params_.window / 2) {}
 
-bool HarrisGlobal::process(const Event& e) noexcept {
+bool HarrisGlobal::process_unchecked(const Event& e) noexcept {
     const int p = e.p != 0;
     const std::size_t id = sae_.index(e.x, e.y);
     const std::uint64_t previous = sae_.plane(p)[id];
-    const std::uint64_t seq = sae_.update(e);
+    const std::uint64_t seq = sae_.update_unchecked(e);
     newest_[p].push(id, seq, previous, sae_.plane(p));
     score_ = kNoScore;
     const SensorSize s = sae_.size();

@@ -1,8 +1,18 @@
 #include "evcorner/sensor.hpp"
 
 #include <charconv>
+#include <stdexcept>
+#include <string>
 
 namespace evcorner {
+
+SensorSize checked_sensor_size(SensorSize size, const char* who) {
+    if (size.width < 1 || size.height < 1 || size.width > kMaxSensorSide || size.height > kMaxSensorSide)
+        throw std::invalid_argument(std::string(who) + ": sensor size " + std::to_string(size.width) + "x" +
+                                    std::to_string(size.height) + " is outside 1x1.." + std::to_string(kMaxSensorSide) +
+                                    "x" + std::to_string(kMaxSensorSide));
+    return size;
+}
 
 std::optional<SensorSize> parse_sensor_size(std::string_view text) {
     const auto sep = text.find_first_of("xX");

@@ -6,14 +6,15 @@
 //
 // Each plane carries a frame of `pad` never-fired cells on every side, so that a
 // window of radius <= pad around any pixel of the sensor can be read without bounds
-// checks (cells outside the sensor read as never fired).
+// checks (cells outside the sensor read as never fired). The planes start as zero
+// pages (zeroed_array.hpp): memory is committed only where events write.
 
 #include <cstddef>
 #include <cstdint>
-#include <vector>
 
 #include "evcorner/event.hpp"
 #include "evcorner/sensor.hpp"
+#include "evcorner/zeroed_array.hpp"
 
 namespace evcorner {
 
@@ -27,7 +28,14 @@ public:
           planes_(planes == 1 ? 1 : 2),
           stride_(static_cast<std::size_t>(size.width) + 2 * static_cast<std::size_t>(pad)),
           plane_size_(stride_ * (static_cast<std::size_t>(size.height) + 2 * static_cast<std::size_t>(pad))),
-          cells_(static_cast<std::size_t>(planes_) * plane_size_, 0) {}
+          cells_(static_cast<std::size_t>(planes_) * plane_size_) {}
+
+    /// Bytes of state for a sensor of `size` with a frame of `pad` and `planes` planes.
+    [[nodiscard]] static constexpr std::uint64_t state_bytes(SensorSize size, int pad, int planes = 2) noexcept {
+        return static_cast<std::uint64_t>(planes == 1 ? 1 : 2) *
+               (static_cast<std::uint64_t>(size.width) + 2 * static_cast<std::uint64_t>(pad)) *
+               (static_cast<std::uint64_t>(size.height) + 2 * static_cast<std::uint64_t>(pad)) * sizeof(std::uint64_t);
+    }
 
     [[nodiscard]] SensorSize size() const noexcept { return size_; }
     [[nodiscard]] int pad() const noexcept { return pad_; }
@@ -43,8 +51,9 @@ public:
     }
     [[nodiscard]] std::uint64_t at(int p, int x, int y) const noexcept { return plane(p)[index(x, y)]; }
 
-    /// Stamps `e` with the next sequence number and returns it.
-    std::uint64_t update(const Event& e) noexcept {
+    /// Stamps `e` with the next sequence number and returns it. `e` must lie on the
+    /// sensor (unchecked).
+    std::uint64_t update_unchecked(const Event& e) noexcept {
         cells_[static_cast<std::size_t>(e.p != 0 && planes_ == 2) * plane_size_ + index(e.x, e.y)] = ++last_;
         return last_;
     }
@@ -61,7 +70,7 @@ private:
     int planes_;
     std::size_t stride_;
     std::size_t plane_size_;
-    std::vector<std::uint64_t> cells_;
+    ZeroedArray<std::uint64_t> cells_;
     std::uint64_t last_ = 0;
 };
 

@@ -20,6 +20,7 @@
 #include "evcorner/circle.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/event.hpp"
+#include "evcorner/event_check.hpp"
 #include "evcorner/sae.hpp"
 #include "evcorner/sensor.hpp"
 
@@ -31,24 +32,40 @@ public:
     static constexpr int kArc4Min = 4, kArc4Max = 8;
 
     /// `planes` = 1 keeps one SAE plane for both polarities: only for a caller that feeds
-    /// events of one polarity (ParallelDetector's parts), at half the memory.
-    explicit EFast(SensorSize size, int planes = 2) : sae_(size, planes) {}
+    /// events of one polarity (ParallelDetector's parts), at half the memory. Throws
+    /// std::invalid_argument for a side outside 1..kMaxSensorSide.
+    explicit EFast(SensorSize size, int planes = 2) : sae_(checked_sensor_size(size, "eFAST"), planes) {}
 
-    /// Updates the SAE with `e` and answers whether `e` is a corner event.
-    /// `e` must lie on the sensor (readers validate).
-    bool process(const Event& e) noexcept { return process_with<ScalarSearch>(e); }
+    /// Bytes of state a detector over `size` holds (8 per pixel and plane), allocated
+    /// as zero pages that are committed only where events land.
+    [[nodiscard]] static constexpr std::uint64_t state_bytes(SensorSize size, int planes = 2) noexcept {
+        return Sae::state_bytes(size, planes);
+    }
 
-    /// process() with a chosen way of finding a circle's newest pixel (arc_test.hpp).
+    /// What process() accepts: events on the sensor, polarity 0/1, time within the
+    /// SAE's range (Sae::kMinTime..kMaxTime, about +-146 000 years).
+    [[nodiscard]] EventLimits limits() const noexcept { return {sae_.size(), Sae::kMinTime, Sae::kMaxTime}; }
+
+    /// Updates the SAE with `e` and answers whether `e` is a corner event. Throws
+    /// InvalidEvent (state unchanged) for an event limits() does not accept.
+    bool process(const Event& e) {
+        check_event(e, limits());
+        return process_unchecked(e);
+    }
+    /// process() without the check: `e` must be accepted by limits().
+    bool process_unchecked(const Event& e) noexcept { return process_unchecked_with<ScalarSearch>(e); }
+
+    /// process_unchecked() with a chosen way of finding a circle's newest pixel (arc_test.hpp).
     template <class Search>
-    bool process_with(const Event& e) noexcept {
+    bool process_unchecked_with(const Event& e) noexcept {
         return View::template make<Search>(sae_).template process<Search>(e);
     }
 
-    /// detect() over a span with a chosen search. The sensor geometry and plane pointers
-    /// are held in locals for the whole loop: stores of the one-byte flags may alias
-    /// anything, so members would be reloaded (and offsets recomputed) every event.
+    /// detect_unchecked() over a span with a chosen search. The sensor geometry and plane
+    /// pointers are held in locals for the whole loop: stores of the one-byte flags may
+    /// alias anything, so members would be reloaded (and offsets recomputed) every event.
     template <class Search>
-    std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
         const View v = View::template make<Search>(sae_);
         std::size_t corners = 0;
         for (std::size_t i = 0; i < events.size(); ++i) {
@@ -93,7 +110,7 @@ private:
         template <class Search>
         bool process(const Event& e) const noexcept {
             std::int64_t* const centre = plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x;
-            *centre = e.t;  // the SAE update, border events included
+            *centre = Sae::stored(e.t);  // the SAE update, border events included
             if (e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
                 e.y >= height - kCircleMargin)
                 return false;
@@ -121,14 +138,18 @@ static_assert(Detector<EFast>);
 /// detect() for eFAST: the same flags, with the fastest code this CPU runs (AVX-512,
 /// else AVX2, else portable), chosen once per process; the environment variable
 /// EVCORNER_EFAST_PATH=portable|avx2|avx512 forces one this CPU runs. Overload
-/// resolution picks it over the generic detect() of detector.hpp.
-std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+/// resolution picks it over the generic detect() of detector.hpp. Checks as that one
+/// does (InvalidEvent before any event is processed).
+std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
+/// detect() without the checks: every event accepted by det.limits(), is_corner at
+/// least as long as events.
+std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
 
 /// The code path detect(EFast&, ...) takes: "avx512", "avx2" or "portable".
 const char* efast_code_path() noexcept;
 /// Every code path this CPU runs, fastest first.
 std::vector<std::string> efast_code_paths();
-/// detect() on a named path (one of efast_code_paths(); else std::invalid_argument).
+/// detect() on a named path (one of efast_code_paths(); else std::invalid_argument), checked.
 std::size_t detect_on_path(std::string_view path, EFast& det, std::span<const Event> events,
                            std::span<std::uint8_t> is_corner);
 

@@ -16,6 +16,7 @@
 #include "evcorner/arrival_sae.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/event.hpp"
+#include "evcorner/event_check.hpp"
 #include "evcorner/harris_score.hpp"
 #include "evcorner/scored_detector.hpp"
 #include "evcorner/sensor.hpp"
@@ -31,14 +32,29 @@ struct HarrisParams {
 
 class Harris {
 public:
-    /// Throws std::invalid_argument for a parameter out of range (the message names it).
-    /// `planes` = 1 keeps one plane of state for both polarities: only for a caller that
-    /// feeds events of one polarity (ParallelDetector's parts), at half the memory.
+    /// Throws std::invalid_argument for a parameter or a sensor side out of range (the
+    /// message names it). `planes` = 1 keeps one plane of state for both polarities: only
+    /// for a caller that feeds events of one polarity (ParallelDetector's parts), at half
+    /// the memory.
     explicit Harris(SensorSize size, HarrisParams params = {}, int planes = 2);
 
-    /// Updates the state with `e` and answers whether `e` is a corner event.
-    /// `e` must lie on the sensor (readers validate).
-    bool process(const Event& e) noexcept;
+    /// Bytes of state a detector over `size` holds: 8 per pixel and plane, the sensor
+    /// framed by window/2 cells on each side; zero pages committed only where events land.
+    [[nodiscard]] static std::uint64_t state_bytes(SensorSize size, const HarrisParams& params = {}, int planes = 2) noexcept {
+        return ArrivalSae::state_bytes(size, params.window / 2, planes);
+    }
+
+    /// What process() accepts: events on the sensor with polarity 0/1 (any time).
+    [[nodiscard]] EventLimits limits() const noexcept { return {sae_.size()}; }
+
+    /// Updates the state with `e` and answers whether `e` is a corner event. Throws
+    /// InvalidEvent (state unchanged) for an event limits() does not accept.
+    bool process(const Event& e) {
+        check_event(e, limits());
+        return process_unchecked(e);
+    }
+    /// process() without the check: `e` must be accepted by limits().
+    bool process_unchecked(const Event& e) noexcept;
 
     /// Score of the latest processed event; kNoScore (NaN) for a border event, when fewer
     /// than nl distinct pixels of its polarity have fired in its window, or before any event.

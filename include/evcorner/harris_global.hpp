@@ -19,6 +19,7 @@
 #include "evcorner/arrival_sae.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/event.hpp"
+#include "evcorner/event_check.hpp"
 #include "evcorner/harris_score.hpp"
 #include "evcorner/newest_pixels.hpp"
 #include "evcorner/scored_detector.hpp"
@@ -35,12 +36,29 @@ struct HarrisGlobalParams {
 
 class HarrisGlobal {
 public:
-    /// Throws std::invalid_argument for a parameter out of range (the message names it).
+    /// Throws std::invalid_argument for a parameter or a sensor side out of range (the
+    /// message names it).
     explicit HarrisGlobal(SensorSize size, HarrisGlobalParams params = {});
 
-    /// Updates the state with `e` and answers whether `e` is a corner event.
-    /// `e` must lie on the sensor (readers validate).
-    bool process(const Event& e) noexcept;
+    /// Bytes of state a detector over `size` holds: the arrival SAE (8 per pixel and
+    /// polarity, framed by window/2 cells) and the two newest-N rings.
+    [[nodiscard]] static std::uint64_t state_bytes(SensorSize size, const HarrisGlobalParams& params = {}) noexcept {
+        return ArrivalSae::state_bytes(size, params.window / 2) +
+               2 * NewestPixels::state_bytes(static_cast<std::size_t>(params.n > 0 ? params.n : 1),
+                                             static_cast<std::size_t>(size.pixels() > 0 ? size.pixels() : 0));
+    }
+
+    /// What process() accepts: events on the sensor with polarity 0/1 (any time).
+    [[nodiscard]] EventLimits limits() const noexcept { return {sae_.size()}; }
+
+    /// Updates the state with `e` and answers whether `e` is a corner event. Throws
+    /// InvalidEvent (state unchanged) for an event limits() does not accept.
+    bool process(const Event& e) {
+        check_event(e, limits());
+        return process_unchecked(e);
+    }
+    /// process() without the check: `e` must be accepted by limits().
+    bool process_unchecked(const Event& e) noexcept;
 
     /// Score of the latest processed event; kNoScore (NaN) for a border event or before
     /// any event.

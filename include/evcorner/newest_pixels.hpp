@@ -25,8 +25,12 @@ class NewestPixels {
 public:
     /// `n` >= 1: the size of the set. `max_pixels`: how many distinct pixel ids can occur
     /// (bounds the ring when n exceeds it).
-    NewestPixels(std::size_t n, std::size_t max_pixels)
-        : n_(n), ring_(2 * std::min(n, std::max<std::size_t>(max_pixels, 1)) + 1) {}
+    NewestPixels(std::size_t n, std::size_t max_pixels) : n_(n), ring_(ring_size(n, max_pixels)) {}
+
+    /// Bytes a set of `n` over `max_pixels` pixel ids holds.
+    [[nodiscard]] static constexpr std::uint64_t state_bytes(std::size_t n, std::size_t max_pixels) noexcept {
+        return static_cast<std::uint64_t>(ring_size(n, max_pixels)) * sizeof(Entry);
+    }
 
     /// Records that pixel `id` fired with sequence number `seq` (larger than any before).
     /// `latest[id]` must already hold `seq`; `previous` is what it held before (0 = never).
@@ -59,6 +63,9 @@ private:
         std::size_t id;
         std::uint64_t seq;
     };
+    static constexpr std::size_t ring_size(std::size_t n, std::size_t max_pixels) noexcept {
+        return 2 * std::min(n, std::max<std::size_t>(max_pixels, 1)) + 1;
+    }
     [[nodiscard]] std::size_t wrap(std::size_t i) const noexcept { return i >= ring_.size() ? i - ring_.size() : i; }
     [[nodiscard]] static bool valid(const Entry& en, const std::uint64_t* latest) noexcept {
         return latest[en.id] == en.seq;

@@ -21,6 +21,10 @@
 //
 // Threads, clocks and allocation stay outside the detectors: each part runs the
 // detector's own batch loop (detector.hpp; eFAST's fastest path from efast.hpp).
+//
+// detect() and prepare() check every event as the detector's detect() does (InvalidEvent
+// for an event off the sensor, with polarity other than 0/1, or a time the detector
+// cannot hold) before any of it is used; the parts then run the unchecked loop.
 
 #include <algorithm>
 #include <atomic>
@@ -36,6 +40,7 @@
 
 #include "evcorner/detector.hpp"
 #include "evcorner/event.hpp"
+#include "evcorner/event_check.hpp"
 #include "evcorner/sensor.hpp"
 
 namespace evcorner {
@@ -73,10 +78,14 @@ struct DetectPart {
 std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::span<const Event> sample);
 
 namespace detail {
-// The detector's batch loop: an unqualified call, so that argument-dependent lookup
+// The detector's batch loops: unqualified calls, so that argument-dependent lookup
 // finds a detector's own overload (eFAST's, in efast.hpp) over the generic one.
 template <class D>
 std::size_t run_batch(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    return detect_unchecked(det, events, is_corner);
+}
+template <class D>
+std::size_t run_batch_checked(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
     return detect(det, events, is_corner);
 }
 
@@ -102,28 +111,42 @@ public:
     /// `parts_per_thread` parts per thread are handed out per batch.
     template <class Make>
     ParallelDetector(SensorSize size, int threads, int radius, Make make, int parts_per_thread = 4)
-        : size_(size), radius_(radius), parts_per_thread_(std::max(1, parts_per_thread)),
-          pool_(std::max(1, threads)), make_(std::move(make)) {
-        if (pool_.size() == 1) single_ = std::make_unique<D>(make_(size_, 2));
+        : size_(checked_sensor_size(size, "ParallelDetector")), radius_(radius),
+          parts_per_thread_(std::max(1, parts_per_thread)), pool_(std::max(1, threads)), make_(std::move(make)) {
+        if (pool_.size() == 1) {
+            single_ = std::make_unique<D>(make_(size_, 2));
+            limits_ = single_->limits();
+        } else {
+            limits_ = make_(SensorSize{1, 1}, 1).limits();  // the detector's time range
+            limits_.size = size_;
+        }
     }
+
+    /// What detect() and prepare() accept (the detector's limits over the whole sensor).
+    [[nodiscard]] const EventLimits& limits() const noexcept { return limits_; }
 
     [[nodiscard]] int threads() const noexcept { return pool_.size(); }
     [[nodiscard]] std::span<const DetectPart> parts() const noexcept { return plan_; }
 
     /// Like detect(det, events, is_corner) for a single detector, continuing the stream:
     /// prepare() and run() over the span in batches, preparing batch k + 1 while batch k
-    /// is detected. Not while batches of prepare() wait for their run().
+    /// is detected. Not while batches of prepare() wait for their run(). Throws
+    /// InvalidEvent for the first event limits() does not accept, before detecting any.
     std::size_t detect(std::span<const Event> events, std::span<std::uint8_t> is_corner) {
-        if (single_) return detail::run_batch(*single_, events, is_corner);
+        if (single_) return detail::run_batch_checked(*single_, events, is_corner);
         if (queued_ != 0) throw std::logic_error("ParallelDetector::detect: batches prepared and not run");
+        if (is_corner.size() < events.size())
+            throw std::invalid_argument("ParallelDetector::detect: fewer flags than events");
+        check_events(events, limits_);
         std::size_t corners = 0;
         if (events.empty()) return 0;
-        prepare(events.first(std::min(kMaxBatch, events.size())));
+        prepare_unchecked(events.first(std::min(kMaxBatch, events.size())));
         for (std::size_t at = 0; at < events.size(); at += kMaxBatch) {
             const std::size_t n = std::min(kMaxBatch, events.size() - at);
             const std::size_t next = at + n;
             corners += run(is_corner.subspan(at, n), [&] {
-                if (next < events.size()) prepare(events.subspan(next, std::min(kMaxBatch, events.size() - next)));
+                if (next < events.size())
+                    prepare_unchecked(events.subspan(next, std::min(kMaxBatch, events.size() - next)));
             });
         }
         return corners;
@@ -131,8 +154,14 @@ public:
 
     /// Queues the next batch (at most kMaxBatch events, kept alive by the caller until its
     /// run() returns): sorts it out to the parts. At most two batches are queued; the
-    /// first batch plans the parts.
+    /// first batch plans the parts. Throws InvalidEvent for the first event limits() does
+    /// not accept (nothing queued).
     void prepare(std::span<const Event> events) {
+        check_events(events, limits_);
+        prepare_unchecked(events);
+    }
+    /// prepare() without the check of the events: each must be accepted by limits().
+    void prepare_unchecked(std::span<const Event> events) {
         if (events.size() > kMaxBatch) throw std::length_error("ParallelDetector::prepare: batch too large");
         if (queued_ == 2) throw std::logic_error("ParallelDetector::prepare: two batches queued already");
         if (plan_.empty()) make_parts(events);
@@ -297,6 +326,7 @@ private:
     }
 
     SensorSize size_;
+    EventLimits limits_;
     int radius_;
     int parts_per_thread_;
     WorkerPool pool_;

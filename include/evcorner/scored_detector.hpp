@@ -24,19 +24,29 @@ concept ScoredDetector = Detector<D> && requires(const D& d) {
     { d.last_score() } noexcept -> std::same_as<double>;
 };
 
-/// detect() that also keeps the scores: score[i] = the detector's last_score() after
-/// events[i]. is_corner and score must be at least as long as events.
+/// detect() with scores, without the checks (see detect_unchecked in detector.hpp).
 template <ScoredDetector D>
-std::size_t detect(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
-                   std::span<double> score) noexcept {
+std::size_t detect_unchecked(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             std::span<double> score) noexcept {
     std::size_t corners = 0;
     for (std::size_t i = 0; i < events.size(); ++i) {
-        const bool c = det.process(events[i]);
+        const bool c = det.process_unchecked(events[i]);
         is_corner[i] = static_cast<std::uint8_t>(c);
         score[i] = det.last_score();
         corners += c;
     }
     return corners;
+}
+
+/// detect() that also keeps the scores: score[i] = the detector's last_score() after
+/// events[i]. Checks as detect() does (is_corner and score at least as long as events).
+template <ScoredDetector D>
+std::size_t detect(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                   std::span<double> score) {
+    detail::check_flags(events.size(), is_corner.size(), "detect");
+    detail::check_flags(events.size(), score.size(), "detect (scores)");
+    check_events(events, det.limits());
+    return detect_unchecked(det, events, is_corner, score);
 }
 
 }  // namespace evcorner

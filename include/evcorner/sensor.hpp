@@ -31,6 +31,10 @@ inline constexpr SensorSize kDavis240{240, 180};
 /// Largest side the 16-bit event coordinates can address.
 inline constexpr int kMaxSensorSide = 65536;
 
+/// `size` when both sides lie within 1..kMaxSensorSide; else throws std::invalid_argument
+/// naming `who` (the detector) and the size.
+SensorSize checked_sensor_size(SensorSize size, const char* who);
+
 /// Parses "WxH" (e.g. "1280x720"); nullopt when malformed or out of 1..65536.
 std::optional<SensorSize> parse_sensor_size(std::string_view text);
 
