@@ -177,7 +177,7 @@ double naive_score(const Grid& g) {
     return naive::harris_score_naive(p, 0.04);
 }
 
-// Expected values computed independently (Python, the definition of docs/algorithms.md).
+// Expected values computed independently (Python, the definition of docs/harris.md).
 TEST(HarrisDrawn, StraightEdgeScoresAboutMinus3p5) {
     // A vertical edge 3 pixels wide through the centre; its last row has one pixel, to
     // make 25.

@@ -3,7 +3,7 @@
 //
 // A circle of N timestamps T[0..N) (cyclic) *fires* when some contiguous arc of length
 // L, Lmin <= L <= Lmax, has its oldest timestamp strictly newer than every timestamp on
-// the rest of the circle (Mueggler et al., BMVC 2017, Sec. 2.2; docs/algorithms.md).
+// the rest of the circle (Mueggler et al., BMVC 2017, Sec. 2.2; docs/efast.md).
 //
 // arc_fires() is the linear-time form: a firing arc holds the circle's newest pixel and
 // is exactly the set of the L newest pixels. Grow an arc from the newest pixel, always

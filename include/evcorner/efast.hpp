@@ -5,7 +5,7 @@
 // Per event: write its timestamp into the SAE of its polarity; away from the border,
 // it is a corner iff on that SAE the radius-3 circle has a contiguous arc of 3..6
 // pixels all strictly newer than the rest of the circle, and the radius-4 circle one
-// of 4..8 pixels (docs/algorithms.md fixes every detail).
+// of 4..8 pixels (docs/efast.md gives the exact definition).
 
 #include <array>
 #include <cstddef>

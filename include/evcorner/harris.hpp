@@ -1,7 +1,7 @@
 #pragma once
 // Spatially-adaptive event-based Harris, the improved baseline of
 //   E. Mueggler, C. Bartolozzi, D. Scaramuzza, "Fast Event-based Corner Detection",
-//   BMVC 2017, Sec. 3.2 (docs/algorithms.md fixes every detail).
+//   BMVC 2017, Sec. 3.2 (docs/harris.md gives the exact definition).
 // Per event: the binary w x w patch around it (w = 9) lights the Nl = 25 pixels of its
 // polarity that fired most recently in that window (distinct pixels, ties broken by
 // arrival); the event is a corner iff the Harris score of the patch is > S = 8.

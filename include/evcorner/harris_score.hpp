@@ -5,7 +5,7 @@
 //            Gx = outer([1,4,6,4,1], [1,2,0,-2,-1]) / 12 and Gy = Gx^T  -> (w-4)^2 maps;
 //   A, B, C = sums of h*Ix^2, h*Ix*Iy, h*Iy^2 with h a (w-4)^2 Gaussian, sigma 1, sum 1;
 //   H = A*C - B^2 - k*(A+C)^2.
-// For w = 9 this is exactly docs/algorithms.md (5x5 gradient maps, 5x5 Gaussian).
+// For w = 9 this is exactly the definition of docs/harris.md (5x5 gradient maps, 5x5 Gaussian).
 //
 // The patch is given as one bit mask per row (bit c = column c). Gradients are summed
 // in integers with 12*G (integer coefficients) and scaled once at the end, so the result

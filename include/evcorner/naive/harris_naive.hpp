@@ -1,6 +1,6 @@
 #pragma once
 // The event-based Harris detectors written plainly from their definitions, as oracles
-// for the fast paths (docs/algorithms.md; Mueggler et al., BMVC 2017, Sec. 3.2;
+// for the fast paths (docs/harris.md; Mueggler et al., BMVC 2017, Sec. 3.2;
 // Vasco et al., IROS 2016):
 // - HarrisNaive: keeps every event of the stream; per event, fully sorts the fired
 //   pixels of the window by arrival and lights the newest nl of them;
