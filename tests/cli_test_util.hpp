@@ -3,6 +3,7 @@
 // own per test, through the shell, both output streams captured.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <sys/wait.h>
 
@@ -42,7 +43,8 @@ protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = fs::temp_directory_path() /
-               (std::string("evcorner-") + info->test_suite_name() + "-" + info->name());
+               (std::string("evcorner-") + info->test_suite_name() + "-" + info->name() + "-" +
+                std::to_string(::getpid()));  // two test runs side by side keep apart
         fs::remove_all(dir_);
         fs::create_directories(dir_);
     }

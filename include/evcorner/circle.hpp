@@ -1,7 +1,8 @@
 #pragma once
 // The two Bresenham circles eFAST samples around an event (Mueggler et al., BMVC 2017,
 // Fig. 3): radius 3 with 16 pixels and radius 4 with 20 pixels, in cyclic order.
-// The order is the one of docs/efast.md; tests check count, distinctness,
+// The order is the one of the authors' reference implementation (arcs are contiguous in
+// it; docs/efast.md); tests check count, distinctness,
 // distance from the centre and symmetry.
 
 #include <array>
