@@ -136,6 +136,18 @@ TimeAxis time_unit_for(std::int64_t span_us) {
     return {1e6, "s"};
 }
 
+// The canvas both frames share: `width` wide, the legend's rows below `legend_top`, the
+// title drawn and the body pasted at (left, top).
+Framed start_frame(const RgbImage& body, const FigureFrame& f, const Ink& k, int left, int top, int width,
+                   int legend_top) {
+    const int rows = legend_rows(nullptr, f, k, k.pad, 0, width - 2 * k.pad);
+    const int height = legend_top + legend_height(rows, k) + k.pad / 2;
+    Framed out{RgbImage(width, height, kFrameBackground), left, top};
+    draw_title(out.image, f, k);
+    out.image.paste(body, left, top);
+    return out;
+}
+
 }  // namespace
 
 Framed frame_sensor_figure(const RgbImage& body, SensorSize size, int scale, const FigureFrame& f) {
@@ -153,13 +165,9 @@ Framed frame_sensor_figure(const RgbImage& body, SensorSize size, int scale, con
     int width = left + body.width() + 1 + std::max(k.pad, last_label / 2 + k.pad / 2);
     width = std::max(width, widest(f.title, k.ts) + 2 * k.pad);
     const int legend_top = top + body.height() + 1 + k.tick + 2 * k.ts + 2 * k.line + k.pad / 2;
-    const int rows = legend_rows(nullptr, f, k, k.pad, 0, width - 2 * k.pad);
-    const int height = legend_top + legend_height(rows, k) + k.pad / 2;
 
-    Framed out{RgbImage(width, height, kFrameBackground), left, top};
+    Framed out = start_frame(body, f, k, left, top, width, legend_top);
     RgbImage& img = out.image;
-    draw_title(img, f, k);
-    img.paste(body, left, top);
     // The axes: a box one pixel outside the body.
     const int x0 = left - 1, y0 = top - 1, x1 = left + body.width(), y1 = top + body.height();
     img.line(x0, y0, x1, y0, kAxisInk);
@@ -219,13 +227,9 @@ Framed frame_space_time_figure(const RgbImage& body, SensorSize size, std::int64
     int width = left + body.width() + std::max(k.pad, ylab + k.tick + gap + k.pad - lay.margin);
     width = std::max(width, widest(f.title, k.ts) + 2 * k.pad);
     const int legend_top = top + body.height() + k.tick + 2 * k.ts + 2 * k.line - lay.margin + k.pad / 2;
-    const int rows = legend_rows(nullptr, f, k, k.pad, 0, width - 2 * k.pad);
-    const int height = legend_top + legend_height(rows, k) + k.pad / 2;
 
-    Framed out{RgbImage(width, height, kFrameBackground), left, top};
+    Framed out = start_frame(body, f, k, left, top, width, legend_top);
     RgbImage& img = out.image;
-    draw_title(img, f, k);
-    img.paste(body, left, top);
     auto at = [&](double x, double y, double tau, int& u, int& v) {
         lay.project(x, y, tau, u, v);
         u += left;
