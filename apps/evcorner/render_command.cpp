@@ -69,14 +69,6 @@ struct RenderOptions {
     std::string overlap = "any";
 };
 
-io::ReaderOptions reader_options(const InputOptions& o) {
-    io::ReaderOptions r;
-    if (!o.size.empty()) r.sensor = parse_sensor_size(o.size);
-    r.csv_columns = o.csv_columns;
-    r.csv_time_unit = o.time_unit;
-    return r;
-}
-
 std::string seconds(std::int64_t us) { return fmt::format("{:.6f} s", static_cast<double>(us) * 1e-6); }
 
 std::string duration(std::int64_t us) {
@@ -203,9 +195,9 @@ struct Kept {
 
 // Reads the input batch by batch, detects, keeps what `need` asks for.
 Kept stream_input(const RenderOptions& o, const Need& need, bool detect_here) {
-    const auto reader = io::open_event_reader(o.input, reader_options(o.in), o.in.format);
+    const auto reader = open_events(o.input, o.in);
     Kept k;
-    k.size = reader->sensor().value_or(kDavis240);
+    k.size = sensor_of(*reader);
     std::optional<AnyDetector> detector;
     if (detect_here) detector = make_detector(o.detector, k.size);
     // --at known from the first event on (seconds, "+S"), or only at the end (absent, "-S").
@@ -282,7 +274,7 @@ Kept stream_input(const RenderOptions& o, const Need& need, bool detect_here) {
 
 // Corner events from a file, streamed: those of [lo, hi].
 std::vector<Event> stream_corners_file(const RenderOptions& o, std::int64_t lo, std::int64_t hi) {
-    const auto reader = io::open_event_reader(o.corners_file, reader_options(o.in), o.in.format);
+    const auto reader = open_events(o.corners_file, o.in);
     std::vector<Event> out;
     std::vector<Event> batch(kBatch);
     for (;;) {
