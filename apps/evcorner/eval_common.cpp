@@ -21,25 +21,12 @@ std::unique_ptr<io::EventReader> open_events(const std::string& path, const Inpu
 
 SensorSize sensor_of(const io::EventReader& reader) { return reader.sensor().value_or(kDavis240); }
 
-LoadedEvents load_events(const std::string& path, const InputOptions& o) {
-    const auto reader = open_events(path, o);
-    LoadedEvents out;
-    out.events = io::read_all_events(*reader);
-    out.size = sensor_of(*reader);
-    return out;
-}
-
 LoadedEvents load_events(const std::string& path, const InputOptions& o, bool progress) {
     const auto reader = open_events(path, o);
     Progress bar(progress, reader->bytes_total());
     LoadedEvents out;
-    std::vector<Event> batch(std::size_t{1} << 16);
-    for (;;) {
-        const std::size_t n = reader->read(batch);
-        if (n == 0 && reader->skipped_in_batch().empty()) break;
-        out.events.insert(out.events.end(), batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(n));
-        bar.update(reader->bytes_consumed(), out.events.size());
-    }
+    out.events = io::read_all_events(
+        *reader, [&](const std::vector<Event>& all) { bar.update(reader->bytes_consumed(), all.size()); });
     bar.finish();
     out.size = sensor_of(*reader);
     return out;

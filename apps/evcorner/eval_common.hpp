@@ -29,14 +29,12 @@ struct LoadedEvents {
     SensorSize size;
 };
 
-/// Reads every event of `path` into memory (the evaluation needs random access).
-LoadedEvents load_events(const std::string& path, const InputOptions& o);
-
-/// Opens `path` for reading batch by batch, with the same options as load_events.
+/// Opens `path` for reading batch by batch, with the options of the command line.
 std::unique_ptr<io::EventReader> open_events(const std::string& path, const InputOptions& o);
 
-/// load_events with a progress bar on standard error (when it is a terminal and `progress`).
-LoadedEvents load_events(const std::string& path, const InputOptions& o, bool progress);
+/// Reads every event of `path` into memory (label, bench: random access), with a progress
+/// bar on standard error when `progress` and it is a terminal.
+LoadedEvents load_events(const std::string& path, const InputOptions& o, bool progress = false);
 
 /// The sensor events of `reader` are on: its own, else 240x180.
 SensorSize sensor_of(const io::EventReader& reader);

@@ -68,15 +68,21 @@ public:
 };
 
 /// The whole stream into memory (tools and tests that need every event at once), read
-/// by the contract: batches until one is empty with no skip runs. Throws InputError.
-inline std::vector<Event> read_all_events(EventReader& reader) {
+/// by the contract: batches until one is empty with no skip runs. `after_batch(all)` is
+/// called after each batch (a progress bar). Throws InputError.
+template <class AfterBatch>
+std::vector<Event> read_all_events(EventReader& reader, AfterBatch&& after_batch) {
     std::vector<Event> all;
     std::vector<Event> batch(std::size_t{1} << 16);
     for (;;) {
         const std::size_t n = reader.read(batch);
         if (n == 0 && reader.skipped_in_batch().empty()) return all;
         all.insert(all.end(), batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(n));
+        after_batch(static_cast<const std::vector<Event>&>(all));
     }
+}
+inline std::vector<Event> read_all_events(EventReader& reader) {
+    return read_all_events(reader, [](const std::vector<Event>&) {});
 }
 
 }  // namespace evcorner::io
