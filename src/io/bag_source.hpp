@@ -28,6 +28,8 @@ struct BagMessage {
     std::optional<std::uint64_t> offset;
     /// Where the message is when it has no offset, e.g. "in the lz4 chunk at byte 4096".
     std::string where;
+    /// File offset of the (compressed) chunk that holds it, when it has no offset.
+    std::optional<std::uint64_t> chunk_at;
 };
 
 class BagSource {

@@ -42,6 +42,8 @@ public:
                              n < 8 ? "the file ends inside the MCAP magic bytes: it is cut short"
                                    : "not an MCAP file (it must start with '\\x89MCAP0\\r\\n')");
         if (!read_summary()) scan();
+        // No channel before the damage: the damage is the news.
+        if (channels_.empty() && scan_error_) std::rethrow_exception(scan_error_);
         build_topics();
     }
 
@@ -157,6 +159,7 @@ private:
             while (step()) {
             }
         } catch (const InputError&) {
+            scan_error_ = std::current_exception();
         }
         counting_ = false;
         restart();
@@ -259,6 +262,7 @@ private:
                 current_.offset = chunk_data_at_ + at + kMessageFields;
             else {
                 current_.offset.reset();
+                current_.chunk_at = chunk_at_;
                 current_.where = fmt::format("in the {} chunk at byte {}, its decompressed byte {}", chunk_method_,
                                              chunk_at_, at + kMessageFields);
             }
@@ -321,6 +325,7 @@ private:
     std::vector<BagTopic> topics_;
     std::set<std::uint16_t> selected_;
     bool counting_ = false;
+    std::exception_ptr scan_error_;  // damage the pass over the file met
 
     std::uint64_t pos_ = 8;
     bool ended_ = false;

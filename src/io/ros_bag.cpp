@@ -134,6 +134,8 @@ std::string_view detect_bag_format(std::string_view head) noexcept {
     return {};
 }
 
+std::string escape_bytes(std::string_view s) { return detail::escaped(s); }
+
 bool is_bag_format(std::string_view format) noexcept {
     return format == "rosbag2" || format == "mcap" || format == "rosbag";
 }
@@ -181,8 +183,10 @@ struct BagReader::Impl {
         if (msg.offset)
             throw InputError(src->name(), InputError::Unit::byte, *msg.offset + at,
                              fmt::format("message {} of topic {}: {}", msg.index + 1, detail::escaped(topic), reason));
-        throw InputError(src->name(), fmt::format("message {} of topic {} ({}), payload byte {}: {}", msg.index + 1,
-                                                  detail::escaped(topic), msg.where, at, reason));
+        const std::string what = fmt::format("message {} of topic {} ({}), payload byte {}: {}", msg.index + 1,
+                                             detail::escaped(topic), msg.where, at, reason);
+        if (msg.chunk_at) throw InputError(src->name(), InputError::Unit::byte, *msg.chunk_at, what);
+        throw InputError(src->name(), what);
     }
 
     void push(std::int64_t t, std::uint32_t ex, std::uint32_t ey, bool on, std::uint64_t at) {

@@ -89,6 +89,7 @@ public:
         } else {
             end_ = size_;
             scan();
+            if (conns_.empty() && scan_error_) std::rethrow_exception(scan_error_);
         }
         std::map<std::string, std::size_t> at;
         for (const auto& [id, c] : conns_) {
@@ -219,6 +220,7 @@ private:
             while (step()) {
             }
         } catch (const InputError&) {
+            scan_error_ = std::current_exception();
         }
         counting_ = false;
     }
@@ -302,6 +304,7 @@ private:
             current_.offset = chunk_data_at_ + data_at;
         else {
             current_.offset.reset();
+            current_.chunk_at = chunk_at_;
             current_.where = fmt::format("in the {} chunk at byte {}, its decompressed byte {}", chunk_method_,
                                          chunk_at_, data_at);
         }
@@ -346,6 +349,7 @@ private:
     std::vector<BagTopic> topics_;
     std::set<std::uint32_t> selected_;
     bool counting_ = false;
+    std::exception_ptr scan_error_;  // damage the pass over the file met
 
     Fields fields_;
     std::vector<unsigned char> header_;

@@ -4,6 +4,8 @@
 #include <sqlite3.h>
 
 #include <fmt/format.h>
+#include <filesystem>
+#include <fstream>
 #include <map>
 
 #include "bag_source.hpp"
@@ -12,13 +14,40 @@ namespace evcorner::io::detail {
 
 namespace {
 
+std::uint32_t be(const unsigned char* p, int n) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < n; ++i) v = v << 8 | p[i];
+    return v;
+}
+
+// SQLite reads a file cut short as if its missing pages were there (zero rows): the
+// header's page count (when valid: bytes 24..27 equal bytes 92..95) says how long the
+// file must be.
+void check_length(const std::string& name, const unsigned char* h, std::size_t have, std::uint64_t size) {
+    if (have < 100) throw InputError(name, InputError::Unit::byte, have, "the file ends inside the SQLite header: it is cut short");
+    const std::uint32_t page = be(h + 16, 2) == 1 ? 65536 : be(h + 16, 2);
+    const std::uint32_t pages = be(h + 28, 4);
+    if (pages == 0 || be(h + 24, 4) != be(h + 92, 4)) return;
+    const std::uint64_t want = std::uint64_t{pages} * page;
+    if (want > size)
+        throw InputError(name, InputError::Unit::byte, size,
+                         fmt::format("the file ends here, but its SQLite header declares {} pages of {} bytes ({} bytes): "
+                                     "it is cut short", pages, page, want));
+}
+
 class SqliteBag final : public BagSource {
 public:
     SqliteBag(std::string name, std::span<const unsigned char> image) : name_(std::move(name)) {
         if (image.data() == nullptr) {
+            unsigned char h[100] = {};
+            std::ifstream in(name_, std::ios::binary);
+            in.read(reinterpret_cast<char*>(h), sizeof h);
+            std::error_code ec;
+            check_length(name_, h, static_cast<std::size_t>(in.gcount()), std::filesystem::file_size(name_, ec));
             if (sqlite3_open_v2(name_.c_str(), &db_.p, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) fail("cannot open");
         } else {
             // The fuzz targets: an image in memory, read-only, not copied.
+            check_length(name_, image.data(), image.size(), image.size());
             if (sqlite3_open_v2(":memory:", &db_.p, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK) fail("cannot open");
             auto* bytes = const_cast<unsigned char*>(image.data());
             const auto n = static_cast<sqlite3_int64>(image.size());

@@ -76,6 +76,8 @@ struct BagTopic {
 /// "rosbag2" (SQLite), "mcap" or "rosbag" (ROS 1) when `head` starts with that
 /// container's magic bytes, else empty.
 std::string_view detect_bag_format(std::string_view head) noexcept;
+/// `s` for a message or a listing: printable ASCII kept, other bytes as \xNN.
+std::string escape_bytes(std::string_view s);
 /// Whether `format` names a bag format (rosbag2, mcap, rosbag).
 bool is_bag_format(std::string_view format) noexcept;
 
