@@ -84,23 +84,19 @@ class ChainSource final : public BagSource {
 public:
     ChainSource(std::vector<std::unique_ptr<BagSource>> parts, std::string name, std::string_view format)
         : parts_(std::move(parts)), name_(std::move(name)), format_(format) {
-        std::map<std::string, std::size_t> at;
-        for (const auto& p : parts_)
-            for (const BagTopic& t : p->topics()) {
-                const auto [it, fresh] = at.emplace(t.name, topics_.size());
-                if (fresh)
-                    topics_.push_back(t);
-                else
-                    topics_[it->second].messages += t.messages;
-            }
+        merge(false);
         for (const auto& p : parts_)
             if (p->bytes_total()) total_ += *p->bytes_total();
     }
-    [[nodiscard]] const std::vector<BagTopic>& topics() const noexcept override { return topics_; }
+    [[nodiscard]] const std::vector<BagTopic>& topics() const noexcept override {
+        if (!counted_) merge(true);
+        return topics_;
+    }
+    [[nodiscard]] const std::vector<BagTopic>& topic_types() const noexcept override { return topics_; }
     void select(const std::string& topic) override {
         active_.clear();
         for (std::size_t i = 0; i < parts_.size(); ++i)
-            for (const BagTopic& t : parts_[i]->topics())
+            for (const BagTopic& t : parts_[i]->topic_types())
                 if (t.name == topic) {
                     parts_[i]->select(topic);
                     active_.push_back(i);
@@ -130,10 +126,26 @@ public:
     [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return total_; }
 
 private:
+    // The parts' topics merged by name; with their counts summed when `counts`.
+    void merge(bool counts) const {
+        topics_.clear();
+        std::map<std::string, std::size_t> at;
+        for (const auto& p : parts_)
+            for (const BagTopic& t : counts ? p->topics() : p->topic_types()) {
+                const auto [it, fresh] = at.emplace(t.name, topics_.size());
+                if (fresh)
+                    topics_.push_back(t);
+                else
+                    topics_[it->second].messages += t.messages;
+            }
+        counted_ = counts;
+    }
+
     std::vector<std::unique_ptr<BagSource>> parts_;
     std::string name_;
     std::string_view format_;
-    std::vector<BagTopic> topics_;
+    mutable std::vector<BagTopic> topics_;
+    mutable bool counted_ = false;
     std::vector<std::size_t> active_;
     std::size_t cur_ = 0;
     std::uint64_t total_ = 0;

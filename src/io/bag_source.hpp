@@ -35,7 +35,10 @@ struct BagMessage {
 class BagSource {
 public:
     virtual ~BagSource() = default;
+    /// The topics with their message counts (which a container may count on the first call).
     [[nodiscard]] virtual const std::vector<BagTopic>& topics() const noexcept = 0;
+    /// The topics' names, types and serialisations; the counts may not be filled in.
+    [[nodiscard]] virtual const std::vector<BagTopic>& topic_types() const noexcept { return topics(); }
     /// Restricts next() to the messages of `topic` (one of topics()), from the start.
     virtual void select(const std::string& topic) = 0;
     /// The next message of the topic; false at the end. The bytes stay valid until the

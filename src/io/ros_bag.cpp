@@ -375,14 +375,14 @@ struct BagReader::Impl {
 
 BagReader::BagReader(std::unique_ptr<detail::BagSource> source, ReaderOptions options)
     : source_(std::move(source)), options_(std::move(options)), impl_(std::make_unique<Impl>()) {
-    const auto& topics = source_->topics();
+    const auto& topics = source_->topic_types();
     const BagTopic* chosen = nullptr;
     if (!options_.topic.empty()) {
         for (const BagTopic& t : topics)
             if (t.name == options_.topic) chosen = &t;
         if (!chosen)
             throw InputError(source_->name(), fmt::format("no topic '{}' in the bag (topics: {})",
-                                                          detail::escaped(options_.topic), topic_list(topics)));
+                                                          detail::escaped(options_.topic), topic_list(source_->topics())));
         if (!chosen->events())
             throw InputError(source_->name(),
                              fmt::format("topic {} has type {}, not an event type (event_camera_msgs/EventPacket or "
@@ -398,10 +398,10 @@ BagReader::BagReader(std::unique_ptr<detail::BagSource> source, ReaderOptions op
         if (count == 0)
             throw InputError(source_->name(), fmt::format("the bag has no topic of an event type (event_camera_msgs/"
                                                           "EventPacket or dvs_msgs/EventArray); topics: {}",
-                                                          topic_list(topics)));
+                                                          topic_list(source_->topics())));
         if (count > 1)
             throw InputError(source_->name(), fmt::format("the bag has {} event topics: choose one with --topic "
-                                                          "(topics: {})", count, topic_list(topics)));
+                                                          "(topics: {})", count, topic_list(source_->topics())));
     }
     topic_ = *chosen;
     impl_->src = source_.get();
