@@ -37,7 +37,7 @@ seed aedat2 "$shared"/davis240c-imu-pyaedattools/*.aedat "$shared"/dvs128-walkin
 seed evt2 "$shared"/expelliarmus/evt2_sample.raw "$shared"/faery-testdata/evt2.raw
 seed evt3 "$shared"/expelliarmus/evt3_sample.raw
 seed dat "$shared"/tonic-testdata/sample_ncars.dat
-seed mcap fuzz/seeds/seed.mcap "$shared"/ros2-event-camera-py/test_events_2/*.mcap
+seed mcap fuzz/seeds/*.mcap "$shared"/ros2-event-camera-py/test_events_2/*.mcap
 seed rosbag fuzz/seeds/seed.bag "$shared"/ros2-event-camera-py/ros1/*.bag
 seed rosbag2 fuzz/seeds/seed.db3
 

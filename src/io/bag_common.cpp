@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cstring>
@@ -72,7 +73,7 @@ public:
     explicit MemoryBytes(std::span<const unsigned char> b) : b_(b) {}
     [[nodiscard]] std::uint64_t size() const noexcept override { return b_.size(); }
     void read_at(std::uint64_t offset, std::size_t n, unsigned char* dst) override {
-        std::memcpy(dst, b_.data() + offset, n);
+        if (n > 0) std::memcpy(dst, b_.data() + offset, n);
     }
     [[nodiscard]] std::span<const unsigned char> memory() const noexcept override { return b_; }
 
@@ -188,22 +189,60 @@ std::unique_ptr<BagSource> chain_bags(std::vector<std::unique_ptr<BagSource>> pa
 
 namespace evcorner::io::detail {
 
+// The output grows as it is produced (doubling, up to `size`): a chunk that declares more
+// than it holds costs no more memory than what it holds.
 std::string decompress(std::string_view method, std::span<const unsigned char> src, std::vector<unsigned char>& dst,
                        std::size_t size) {
-    dst.resize(size);
+    std::size_t cap = std::min(size, std::max<std::size_t>(std::size_t{1} << 16, src.size() * 4));
+    dst.resize(cap);
+    std::size_t in = 0, out = 0;
+    // Room for more output: false when `size` bytes are out already.
+    auto grow = [&] {
+        if (out < cap) return true;
+        if (cap == size) return false;
+        cap = std::min(size, cap * 2);
+        dst.resize(cap);
+        return true;
+    };
+    auto more = [&] { return fmt::format("{} data holds more than the {} bytes declared", method, size); };
+    std::string err;
+    int stalls = 0;  // calls in a row that neither read nor wrote: never loop forever
+    const char* stalled = "the compressed data stops decoding (damaged)";
     if (method == "zstd") {
-        const std::size_t r = ZSTD_decompress(dst.data(), size, src.data(), src.size());
-        if (ZSTD_isError(r)) return fmt::format("ZSTD: {}", ZSTD_getErrorName(r));
-        if (r != size) return fmt::format("ZSTD data holds {} bytes, not the {} declared", r, size);
-        return {};
-    }
-    if (method == "lz4") {
+        ZSTD_DCtx* ctx = ZSTD_createDCtx();
+        if (!ctx) throw std::bad_alloc();
+        for (;;) {
+            ZSTD_inBuffer ib{src.data(), src.size(), in};
+            ZSTD_outBuffer ob{dst.data(), cap, out};
+            const std::size_t r = ZSTD_decompressStream(ctx, &ob, &ib);
+            const bool progress = ib.pos != in || ob.pos != out;
+            in = ib.pos;
+            out = ob.pos;
+            if (ZSTD_isError(r)) {
+                err = fmt::format("ZSTD: {}", ZSTD_getErrorName(r));
+                break;
+            }
+            if (r == 0 && in == src.size()) break;  // every frame complete
+            // With the output full, trailing input (a checksum) may still be consumed.
+            if (out == cap && !grow() && !progress) {
+                err = more();
+                break;
+            }
+            if (!progress && out < cap && in == src.size()) {
+                err = "the ZSTD data is cut short";
+                break;
+            }
+            if (!progress && ++stalls > 4) {
+                err = stalled;
+                break;
+            }
+        }
+        ZSTD_freeDCtx(ctx);
+    } else if (method == "lz4") {
         LZ4F_dctx* ctx = nullptr;
         if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) throw std::bad_alloc();
-        std::size_t in = 0, out = 0;
-        std::string err;
         for (;;) {
-            std::size_t src_left = src.size() - in, dst_left = size - out;
+            std::size_t src_left = src.size() - in, dst_left = cap - out;
             const std::size_t r = LZ4F_decompress(ctx, dst.data() + out, &dst_left, src.data() + in, &src_left, nullptr);
             in += src_left;
             out += dst_left;
@@ -211,29 +250,66 @@ std::string decompress(std::string_view method, std::span<const unsigned char> s
                 err = fmt::format("LZ4: {}", LZ4F_getErrorName(r));
                 break;
             }
-            if (r == 0) break;  // the frame is complete
-            if (src_left == 0 && dst_left == 0) {
-                err = in == src.size() ? "the LZ4 frame is cut short" : fmt::format("LZ4 data holds more than the {} bytes declared", size);
+            if (r == 0) {
+                if (in == src.size()) break;  // the frame is complete
+                LZ4F_resetDecompressionContext(ctx);  // another frame follows
+                continue;
+            }
+            const bool progress = src_left != 0 || dst_left != 0;
+            if (out == cap && !grow() && !progress) {
+                err = more();
+                break;
+            }
+            if (!progress && out < cap && in == src.size()) {
+                err = "the LZ4 frame is cut short";
+                break;
+            }
+            if (!progress && ++stalls > 4) {
+                err = stalled;
                 break;
             }
         }
         LZ4F_freeDecompressionContext(ctx);
-        if (err.empty() && out != size) err = fmt::format("LZ4 data holds {} bytes, not the {} declared", out, size);
-        return err;
+    } else if (method == "bz2") {
+        bz_stream bz{};
+        if (BZ2_bzDecompressInit(&bz, 0, 0) != BZ_OK) throw std::bad_alloc();
+        for (;;) {
+            // bzlib counts in unsigned int: feed at most 1 GiB at a time.
+            const std::size_t feed = std::min<std::size_t>(src.size() - in, std::size_t{1} << 30);
+            const std::size_t room = std::min<std::size_t>(cap - out, std::size_t{1} << 30);
+            bz.next_in = const_cast<char*>(reinterpret_cast<const char*>(src.data() + in));
+            bz.avail_in = static_cast<unsigned int>(feed);
+            bz.next_out = reinterpret_cast<char*>(dst.data() + out);
+            bz.avail_out = static_cast<unsigned int>(room);
+            const int r = BZ2_bzDecompress(&bz);
+            const std::size_t used = feed - bz.avail_in, made = room - bz.avail_out;
+            in += used;
+            out += made;
+            if (r == BZ_STREAM_END) break;
+            if (r != BZ_OK) {
+                err = fmt::format("bz2 data is corrupt (bzlib error {})", r);
+                break;
+            }
+            if (out == cap && !grow() && used == 0 && made == 0) {
+                err = more();
+                break;
+            }
+            if (used == 0 && made == 0 && out < cap && in == src.size()) {
+                err = "the bz2 data is cut short";
+                break;
+            }
+            if (used == 0 && made == 0 && ++stalls > 4) {
+                err = stalled;
+                break;
+            }
+        }
+        BZ2_bzDecompressEnd(&bz);
+    } else {
+        return fmt::format("unknown compression '{}'", escaped(method));
     }
-    if (method == "bz2") {
-        if (src.size() > UINT_MAX || size > UINT_MAX) return "bz2 data larger than 4 GiB";
-        auto dst_len = static_cast<unsigned int>(size);
-        // bzlib's prototype takes non-const input it does not write.
-        const int r = BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(dst.data()), &dst_len,
-                                                 const_cast<char*>(reinterpret_cast<const char*>(src.data())),
-                                                 static_cast<unsigned int>(src.size()), 0, 0);
-        if (r == BZ_OUTBUFF_FULL) return fmt::format("bz2 data holds more than the {} bytes declared", size);
-        if (r != BZ_OK) return fmt::format("bz2 data is corrupt (bzlib error {})", r);
-        if (dst_len != size) return fmt::format("bz2 data holds {} bytes, not the {} declared", dst_len, size);
-        return {};
-    }
-    return fmt::format("unknown compression '{}'", escaped(method));
+    if (err.empty() && out != size) err = fmt::format("{} data holds {} bytes, not the {} declared", method, out, size);
+    dst.resize(out);
+    return err;
 }
 
 }  // namespace evcorner::io::detail
