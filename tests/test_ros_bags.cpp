@@ -673,8 +673,12 @@ TEST_F(RosBagCli, ConvertWritesTheSameEvents) {
 TEST_F(RosBagCli, TopicOption) {
     EVCORNER_REQUIRE_SHARED_DATA();
     const std::string bag = real(kRealBags[4].path);
-    CliResult r = run("info --no-progress --topic /event_camera/events '" + bag + "'");
+    CliResult r = run("info --no-progress --topic /event_camera/events --json info.json '" + bag + "'");
     EXPECT_EQ(r.status, 0) << r.err;
+    const std::string json = slurp(dir_ / "info.json");
+    EXPECT_NE(json.find("\"topic\": \"/event_camera/events\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"encoding\": \"evt3\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"messages\": 517"), std::string::npos) << json;
     r = run("info --no-progress --topic /nope '" + bag + "'");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("no topic '/nope' in the bag (topics: /event_camera/events (event_camera_msgs/EventPacket, "
