@@ -27,7 +27,7 @@
 //       "libcaer"     8-byte events {uint32 data, int32 ts}: x = data>>17 & 0x7FFF,
 //                     y = data>>2 & 0x7FFF, polarity = data>>1 & 1;
 //                     t = time_base/1000 + ts [us], + 2^31 us after a roll-over inside
-//                     the packet (ts going backwards)
+//                     the packet (ts jumping back by more than 2^30 us)
 //       "libcaer_cmp" 16-bit words, code = w>>12: 0 time high (t bits 23..12),
 //                     1 time low (bits 11..0), 2 x (w & 0x7FF), 3 y (w & 0x7FF,
 //                     polarity bit 11: one event at x, y), 4 vector base y (polarity
