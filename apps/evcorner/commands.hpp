@@ -17,6 +17,8 @@ void add_bench_command(CLI::App& app);
 /// The input-format options every command shares (--format, --csv-columns, --time-unit, --chip).
 void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit,
                        std::string& chip);
+/// --topic: the topic of a ROS bag to read (ReaderOptions::topic).
+void add_topic_option(CLI::App& cmd, std::string& topic);
 /// --to: the output format (detect, convert); an unknown name is a usage error.
 void add_output_format_option(CLI::App& cmd, std::string& to);
 

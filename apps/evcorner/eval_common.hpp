@@ -22,6 +22,7 @@ struct InputOptions {
     std::string time_unit = "us";
     std::string size;  ///< WxH, empty: the file's own, else 240x180
     std::string chip;  ///< AEDAT 2.0 camera, empty: the header's "# AEChip"
+    std::string topic;  ///< ROS bag topic, empty: the bag's one event topic
 };
 
 struct LoadedEvents {

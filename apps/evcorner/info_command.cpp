@@ -17,6 +17,7 @@
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
+#include "evcorner/io/ros_bag.hpp"
 #include "progress.hpp"
 #include "std_streams.hpp"
 
@@ -34,6 +35,7 @@ struct InfoOptions {
     std::string csv_columns;
     std::string time_unit = "us";
     std::string chip;
+    std::string topic;
     std::string json;
     bool skip_invalid = false;
     bool no_progress = false;
@@ -83,6 +85,25 @@ struct Stats {
     PeakRate peak;
 };
 
+// A ROS bag's topics, the one read marked, and its encoding.
+void print_bag_topics(std::FILE* out, const io::BagReader& bag) {
+    using io::escape_bytes;
+    fmt::print(out, "topic        {} ({}{})\n", escape_bytes(bag.topic().name), escape_bytes(bag.topic().type),
+               bag.encoding().empty() ? "" : ", encoding " + escape_bytes(bag.encoding()));
+    fmt::print(out, "topics       {}\n", bag.topics().size());
+    for (const io::BagTopic& t : bag.topics())
+        fmt::print(out, "  {} {}  {}  {} messages\n", t.name == bag.topic().name ? '*' : ' ', escape_bytes(t.name),
+                   escape_bytes(t.type), t.messages);
+}
+void add_bag_topics(nlohmann::json& j, const io::BagReader& bag) {
+    j["topic"] = bag.topic().name;
+    j["encoding"] = bag.encoding();
+    nlohmann::json topics = nlohmann::json::array();
+    for (const io::BagTopic& t : bag.topics())
+        topics.push_back({{"name", t.name}, {"type", t.type}, {"messages", t.messages}});
+    j["topics"] = topics;
+}
+
 void run_info(const InfoOptions& o) {
     if (!o.json.empty()) io::check_output_paths({{"INPUT", o.input}}, {{"--json", o.json}});
     io::ReaderOptions ropts;
@@ -92,6 +113,7 @@ void run_info(const InfoOptions& o) {
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
     ropts.aedat2_chip = o.chip;
+    ropts.topic = o.topic;
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
     // With the JSON on standard output, the table goes to standard error.
     std::FILE* human = o.json == "-" ? stderr : stdout;
@@ -140,6 +162,8 @@ void run_info(const InfoOptions& o) {
         fmt::print(human, "x range      {}..{}\n", s.x_min, s.x_max);
         fmt::print(human, "y range      {}..{}\n", s.y_min, s.y_max);
     }
+    const auto* bag = dynamic_cast<const io::BagReader*>(reader.get());
+    if (bag) print_bag_topics(human, *bag);
     flush_checked(human);
     if (!o.json.empty()) {
         nlohmann::json j;
@@ -162,6 +186,7 @@ void run_info(const InfoOptions& o) {
             j["y_min"] = s.y_min;
             j["y_max"] = s.y_max;
         }
+        if (bag) add_bag_topics(j, *bag);
         io::OutputFile out(o.json);
         out.write(j.dump(2));
         out.write("\n");
@@ -197,18 +222,26 @@ void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_colu
         });
 }
 
+void add_topic_option(CLI::App& cmd, std::string& topic) {
+    cmd.add_option("--topic", topic,
+                   "ROS bag: the topic to read (event_camera_msgs/EventPacket or dvs_msgs/EventArray) "
+                   "[default: the bag's one event topic]");
+}
+
 void add_info_command(CLI::App& app) {
     auto o = std::make_shared<InfoOptions>();
     CLI::App* cmd = app.add_subcommand(
         "info",
         "Describe an event file: format, sensor size, events, time span, rates, ON/OFF.\n"
         "Prints the format, sensor size, events, time span, mean and peak rate, ON/OFF counts\n"
-        "and x/y ranges. Reads the whole file once, in constant memory.\n"
+        "and x/y ranges (a ROS bag: also its topics, types and message counts, the one read\n"
+        "marked *). Reads the whole file once, in constant memory.\n"
         "Mean rate: events / (last time - first time). Peak rate: the busiest 1 ms bin, bins\n"
         "cut from the first event, the remainder under 1 ms joined to the last bin (a span\n"
         "under 1 ms is one bin), in events per second of the bin's length: never below the mean.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
+    add_topic_option(*cmd, o->topic);
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,7 @@
 #include "evcorner/io/hdf5_events.hpp"
 #include "evcorner/io/npy.hpp"
 #include "evcorner/io/prophesee_header.hpp"
+#include "evcorner/io/ros_bag.hpp"
 #include "evcorner/io/text_reader.hpp"
 
 namespace evcorner::io {
@@ -91,6 +93,7 @@ bool first_data_line(std::string_view head, bool& comma) {
 std::string detect_format(InputFile& file) {
     constexpr std::size_t kLongest = 16;  // covers every signature
     const std::string_view start = file.peek(kLongest);
+    if (const std::string_view bag = detect_bag_format(start); !bag.empty()) return std::string(bag);
     for (const Signature& s : kSignatures)
         if (starts_with(start, s.magic)) return std::string(s.format);
     if (start.size() < kLongest && start.size() >= 2) {
@@ -133,16 +136,23 @@ std::string detect_format(const std::string& path) {
 
 std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOptions options,
                                                std::string_view format) {
+    // A folder is a rosbag2 bag (metadata.yaml and its .db3 / .mcap files).
+    if (std::error_code ec; std::filesystem::is_directory(path, ec)) return open_bag_reader(path, std::move(options), format);
     InputFile file(path);
     std::string fmt_name(format);
     if (fmt_name == "auto") fmt_name = detect_format(file);
     constexpr std::array<std::string_view, 12> kNames = {"ecd-text", "text", "csv", "npy",  "aedat2", "aedat",
                                                          "aedat4",   "evt2", "evt3", "dat", "hdf5",   "h5"};
-    if (std::find(kNames.begin(), kNames.end(), fmt_name) == kNames.end())
+    if (std::find(kNames.begin(), kNames.end(), fmt_name) == kNames.end() && !is_bag_format(fmt_name))
         throw InputError(file.name(), "unknown input format '" + fmt_name + "' (known: " + std::string(kInputFormats) + ")");
     if (!options.aedat2_chip.empty() && fmt_name != "aedat2" && fmt_name != "aedat")
         throw std::invalid_argument(file.name() + ": a camera chip (--chip) names the address layout of an "
                                     "AEDAT 2.0 file; this file is " + fmt_name);
+    if (!options.topic.empty() && !is_bag_format(fmt_name))
+        throw std::invalid_argument(file.name() + ": a topic (--topic) names what to read in a ROS bag; this file is " +
+                                    fmt_name);
+    // Bags are read by seeking: the reader opens the path itself.
+    if (is_bag_format(fmt_name)) return open_bag_reader(path, std::move(options), fmt_name);
     if (fmt_name == "ecd-text" || fmt_name == "text") {
         if (!options.sensor) options.sensor = options.fallback_sensor;
         return std::make_unique<TextReader>(std::move(file), std::move(options));

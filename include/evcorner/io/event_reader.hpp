@@ -39,6 +39,8 @@ struct ReaderOptions {
     std::string aedat2_chip;
     /// CSV only: the unit of the t column: "us" (integers), "ns", "ms" or "s" (decimals).
     std::string csv_time_unit = "us";
+    /// ROS bags only: the topic to read (ros_bag.hpp). Empty: the bag's one event topic.
+    std::string topic;
 };
 
 /// `count` consecutive events skipped as outside the sensor, which stood just before

@@ -15,6 +15,7 @@
 // (keep-alives); they do not advance time. An event before the first TIME_HIGH or
 // ADDR_Y, or a vector before the first VECT_BASE_X, is an error.
 
+#include <memory>
 #include <string>
 
 #include "evcorner/io/binary_reader.hpp"
@@ -25,33 +26,22 @@ class Evt3Reader final : public BinaryReader {
 public:
     /// Reads `file` from its first unread byte and parses its header. Throws InputError.
     explicit Evt3Reader(InputFile file, ReaderOptions options = {});
+    ~Evt3Reader() override;
     /// Opens `path` and parses its header. Throws InputError.
     explicit Evt3Reader(std::string path, ReaderOptions options = {})
         : Evt3Reader(InputFile(std::move(path)), std::move(options)) {}
 
     [[nodiscard]] std::string_view format() const noexcept override { return "evt3"; }
     /// Words of other types (triggers, OTHERS, continued, unknown) skipped so far.
-    [[nodiscard]] std::uint64_t other_words() const noexcept { return other_words_; }
+    [[nodiscard]] std::uint64_t other_words() const noexcept;
 
 private:
     bool decode() override;
-    bool drain_vector();
+    struct Sink;
 
-    std::uint64_t other_words_ = 0;
-    std::int64_t epoch_ = 0;        // multiples of 2^24 us added by wraps
-    std::uint32_t time_high_ = 0;   // 12 bits
-    std::uint32_t time_low_ = 0;    // 12 bits
-    std::int64_t t_ = 0;
-    bool have_high_ = false;
-    std::uint32_t y_ = 0;
-    bool have_y_ = false;
-    std::uint32_t base_x_ = 0;
-    bool have_base_ = false;
-    bool pol_ = false;
-    // A vector word whose events did not all fit the batch.
-    std::uint32_t vec_mask_ = 0;
-    std::uint32_t vec_x_ = 0;
-    std::uint64_t vec_at_ = 0;
+    // The word decoder's state (src/io/evt3_decoder.hpp), kept opaque here.
+    struct DecoderBox;
+    std::unique_ptr<DecoderBox> dec_;
 };
 
 }  // namespace evcorner::io
