@@ -29,14 +29,13 @@ Harris::Harris(SensorSize size, HarrisParams params, int planes)
       sae_(checked_sensor_size(size, "Harris"), params_.window / 2, planes),
       radius_(params_.window / 2) {}
 
-bool Harris::process_unchecked(const Event& e) noexcept {
-    sae_.update_unchecked(e);
-    score_ = kNoScore;
+// One body for both callers, inlined into each (process_unchecked() stays one call).
+[[gnu::always_inline]] inline double Harris::score_window(const Event& e) const noexcept {
     const SensorSize s = sae_.size();
     // The reference's border rule: '>' on the far side, so the window of an event at
     // x = width - r reaches one column past the sensor (read as never fired).
     if (e.x < radius_ || e.x > s.width - radius_ || e.y < radius_ || e.y > s.height - radius_)
-        return false;
+        return kNoScore;
 
     // Select the nl newest fired pixels of the window without sorting: bucket every
     // cell by the bit width of its age in arrivals (octaves, monotone in age; a cell that
@@ -60,7 +59,7 @@ bool Harris::process_unchecked(const Event& e) noexcept {
             ++histogram[i & 3][b];
             fired += seq != 0;
         }
-    if (fired < nl) return false;  // fewer than nl pixels ever fired in the window
+    if (fired < nl) return kNoScore;  // fewer than nl pixels ever fired in the window
 
     int boundary = 0, newer = 0;  // newer: cells in buckets below `boundary`
     for (;;) {
@@ -95,8 +94,15 @@ bool Harris::process_unchecked(const Event& e) noexcept {
         const std::uint64_t key = keys[j];
         rows[key >> 4 & 15] |= static_cast<std::uint16_t>(static_cast<unsigned>(rank < take) << (key & 15));
     }
-    score_ = scorer_.score(rows);
-    return score_ > params_.threshold;
+    return scorer_.score(rows);
 }
+
+bool Harris::process_unchecked(const Event& e) noexcept {
+    sae_.update_unchecked(e);
+    score_ = score_window(e);
+    return score_ > params_.threshold;  // false for kNoScore (NaN)
+}
+
+double Harris::score_latest(const Event& e) const noexcept { return score_window(e); }
 
 }  // namespace evcorner
