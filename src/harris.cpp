@@ -10,6 +10,8 @@ namespace evcorner {
 namespace {
 
 constexpr int kBuckets = 65;  // bit width of an age: 0..64
+// A boundary bucket of more cells than this is split once more before ranking.
+constexpr int kRankDirectly = 12;
 
 HarrisParams validated(HarrisParams p) {
     // The window and k are checked by HarrisScorer; nl depends on the window.
@@ -87,7 +89,31 @@ Harris::Harris(SensorSize size, HarrisParams params, int planes)
     // The `take` newest keys of the boundary bucket are those with fewer than `take` newer
     // keys there. (Cells that never fired have key < 2^8, below every fired cell's, and
     // fired >= nl guarantees they are never taken.)
-    const int take = nl - newer;  // 1..m
+    int take = nl - newer;  // 1..m
+    if (m > kRankDirectly) {
+        // A crowded boundary bucket (ranking it directly costs m^2 compares; with an
+        // active window m often passes 30): split it once more, by the four bits of the
+        // age below its leading bit (ages in [2^(b-1), 2^b) -> 16 sub-buckets, monotone
+        // in age), light the newer sub-buckets, keep the boundary one's keys.
+        const int shift = boundary > 5 ? boundary - 5 : 0;
+        std::uint8_t sub[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
+        std::uint8_t sub_histogram[16] = {};
+        for (int j = 0; j < m; ++j) {
+            const std::uint64_t age = now - (keys[j] >> 8);
+            sub[j] = static_cast<std::uint8_t>((age >> shift) & 15);
+            ++sub_histogram[sub[j]];
+        }
+        int sub_boundary = 0;
+        while (sub_histogram[sub_boundary] < take) take -= sub_histogram[sub_boundary++];
+        int kept = 0;
+        for (int j = 0; j < m; ++j) {
+            const std::uint64_t key = keys[j];
+            rows[key >> 4 & 15] |= static_cast<std::uint16_t>(static_cast<unsigned>(sub[j] < sub_boundary) << (key & 15));
+            keys[kept] = key;
+            kept += sub[j] == sub_boundary;
+        }
+        m = kept;
+    }
     for (int j = 0; j < m; ++j) {
         int rank = 0;
         for (int k = 0; k < m; ++k) rank += keys[k] > keys[j];
