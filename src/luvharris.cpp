@@ -21,11 +21,6 @@ namespace {
 
 __extension__ typedef __int128 Int128;
 
-constexpr int kSmooth5[5] = {1, 4, 6, 4, 1};
-constexpr int kDeriv5[5] = {1, 2, 0, -2, -1};
-constexpr int kSmooth3[3] = {1, 2, 1};
-constexpr int kDeriv3[3] = {1, 0, -1};
-
 [[noreturn]] void bad(const std::string& what) { throw std::invalid_argument("luvHarris " + what); }
 
 LuvHarrisParams validated(const LuvHarrisParams& p) {
@@ -86,19 +81,19 @@ struct BufferSizes {
 BufferSizes buffer_sizes(SensorSize s, const LuvHarrisParams& p) {
     const Geometry g = geometry(s, p);
     return {g.stride * (g.h + 2 * g.pad), g.w * g.h, static_cast<std::size_t>(p.gradient) * g.gw, 3 * g.gw,
-            3 * static_cast<std::size_t>(p.block) * g.w};
+            3 * (static_cast<std::size_t>(p.block) + 1) * g.w};  // the block ring and one accumulator row
 }
 
 }  // namespace
 
 double luv_harris_response(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t k_q, double scale) noexcept {
     const Int128 det = static_cast<Int128>(a) * c - static_cast<Int128>(b) * b;
-    const Int128 tr = static_cast<Int128>(a) + c;
-    const Int128 r = det * 65536 - tr * tr * k_q;  // |r| < 2^106 for every allowed parameter set
+    const std::int64_t tr = a + c;  // < 2^46 for every allowed parameter set
+    const Int128 r = det * 65536 - static_cast<Int128>(tr) * tr * k_q;  // |r| < 2^106 for every allowed parameter set
     // To double: the high part (exact up to its own rounding) times 2^48 (exact), plus the
     // low 48 bits (exact), rounded once; then the scale. The same on every IEEE machine.
     const auto hi = static_cast<std::int64_t>(r >> 48);
-    const auto lo = static_cast<std::uint64_t>(r & ((Int128{1} << 48) - 1));
+    const auto lo = static_cast<std::int64_t>(r & ((Int128{1} << 48) - 1));
     const double value = static_cast<double>(hi) * 281474976710656.0 + static_cast<double>(lo);
     return value * scale;
 }
@@ -175,20 +170,41 @@ namespace {
 // row q (rows -hb..h+hb of the sensor), the horizontal passes of TOS row q+g-1, the
 // vertical pass giving Ix, Iy and their products over gw columns, the horizontal block
 // sums into the block ring; then, once b rows are there, the vertical block sums and the
-// response of sensor row q-b+1.
+// response of sensor row q-b+1. Every inner loop runs along a row with compile-time taps
+// or a tap outside it, so that the compiler vectorises it.
 template <int G>
-void refresh_table(const Geometry& g, const std::uint8_t* tos, std::int16_t* hs, std::int16_t* hd, std::int32_t* prod,
-                   std::int64_t* bring, const std::vector<std::int32_t>& wts, std::int64_t k_q, double scale,
-                   double* table) noexcept {
-    const int* const smooth = G == 5 ? kSmooth5 : kSmooth3;
-    const int* const deriv = G == 5 ? kDeriv5 : kDeriv3;
+struct Taps;
+template <>
+struct Taps<5> {
+    static constexpr int smooth[5] = {1, 4, 6, 4, 1};
+    static constexpr int deriv[5] = {1, 2, 0, -2, -1};
+};
+template <>
+struct Taps<3> {
+    static constexpr int smooth[3] = {1, 2, 1};
+    static constexpr int deriv[3] = {1, 0, -1};
+};
+
+struct RefreshBuffers {
+    std::int16_t* hs;     // G rows x gw
+    std::int16_t* hd;     // G rows x gw
+    std::int32_t* prod;   // 3 x gw
+    std::int64_t* bring;  // b rows x 3 x w
+    std::int64_t* acc;    // 3 x w
+};
+
+// Box: every block weight is 1 (adds only: a 64-bit multiply has no SSE2 instruction).
+template <int G, bool Box>
+void refresh_table(const Geometry& g, const std::uint8_t* tos, const RefreshBuffers& buf,
+                   const std::vector<std::int32_t>& wts, std::int64_t k_q, double scale, double* table) noexcept {
+    constexpr const int* smooth = Taps<G>::smooth;
+    constexpr const int* deriv = Taps<G>::deriv;
     const std::size_t gw = g.gw, w = g.w, b = wts.size();
-    const std::int32_t* const wt = wts.data();
 
     auto horizontal = [&](std::size_t r) {  // TOS row r (padded coordinates) -> ring slot r % G
         const std::uint8_t* in = tos + r * g.stride;
-        std::int16_t* s = hs + (r % G) * gw;
-        std::int16_t* d = hd + (r % G) * gw;
+        std::int16_t* s = buf.hs + (r % G) * gw;
+        std::int16_t* d = buf.hd + (r % G) * gw;
         for (std::size_t c = 0; c < gw; ++c) {
             int sv = 0, dv = 0;
             for (int j = 0; j < G; ++j) {
@@ -201,16 +217,19 @@ void refresh_table(const Geometry& g, const std::uint8_t* tos, std::int16_t* hs,
     };
     for (std::size_t r = 0; r + 1 < G; ++r) horizontal(r);
 
-    std::int32_t* const pxx = prod;
-    std::int32_t* const pxy = prod + gw;
-    std::int32_t* const pyy = prod + 2 * gw;
+    std::int32_t* const pxx = buf.prod;
+    std::int32_t* const pxy = buf.prod + gw;
+    std::int32_t* const pyy = buf.prod + 2 * gw;
+    std::int64_t* const axx = buf.acc;
+    std::int64_t* const axy = buf.acc + w;
+    std::int64_t* const ayy = buf.acc + 2 * w;
     for (std::size_t q = 0; q < g.gh; ++q) {
         horizontal(q + G - 1);
         const std::int16_t* sr[G];
         const std::int16_t* dr[G];
         for (int i = 0; i < G; ++i) {
-            sr[i] = hs + ((q + static_cast<std::size_t>(i)) % G) * gw;
-            dr[i] = hd + ((q + static_cast<std::size_t>(i)) % G) * gw;
+            sr[i] = buf.hs + ((q + static_cast<std::size_t>(i)) % G) * gw;
+            dr[i] = buf.hd + ((q + static_cast<std::size_t>(i)) % G) * gw;
         }
         for (std::size_t c = 0; c < gw; ++c) {
             int ix = 0, iy = 0;
@@ -222,33 +241,37 @@ void refresh_table(const Geometry& g, const std::uint8_t* tos, std::int16_t* hs,
             pxy[c] = ix * iy;
             pyy[c] = iy * iy;
         }
-        std::int64_t* bxx = bring + (q % b) * 3 * w;
-        std::int64_t* bxy = bxx + w;
-        std::int64_t* byy = bxy + w;
-        for (std::size_t x = 0; x < w; ++x) {
-            std::int64_t a = 0, m = 0, c = 0;
-            for (std::size_t j = 0; j < b; ++j) {
-                a += static_cast<std::int64_t>(wt[j]) * pxx[x + j];
-                m += static_cast<std::int64_t>(wt[j]) * pxy[x + j];
-                c += static_cast<std::int64_t>(wt[j]) * pyy[x + j];
+        std::int64_t* const bxx = buf.bring + (q % b) * 3 * w;
+        std::int64_t* const bxy = bxx + w;
+        std::int64_t* const byy = bxy + w;
+        std::fill(bxx, bxx + 3 * w, std::int64_t{0});
+        for (std::size_t j = 0; j < b; ++j) {
+            const std::int64_t wt = wts[j];
+            for (std::size_t x = 0; x < w; ++x) {
+                if constexpr (Box) {
+                    bxx[x] += pxx[x + j];
+                    bxy[x] += pxy[x + j];
+                    byy[x] += pyy[x + j];
+                } else {
+                    bxx[x] += wt * pxx[x + j];
+                    bxy[x] += wt * pxy[x + j];
+                    byy[x] += wt * pyy[x + j];
+                }
             }
-            bxx[x] = a;
-            bxy[x] = m;
-            byy[x] = c;
         }
         if (q + 1 < b) continue;
         const std::size_t y = q + 1 - b;  // sensor row: block rows y..y+b-1 of the ring
-        double* out = table + y * w;
-        for (std::size_t x = 0; x < w; ++x) {
-            std::int64_t a = 0, m = 0, c = 0;
-            for (std::size_t i = 0; i < b; ++i) {
-                const std::int64_t* row = bring + ((y + i) % b) * 3 * w;
-                a += wt[i] * row[x];
-                m += wt[i] * row[w + x];
-                c += wt[i] * row[2 * w + x];
-            }
-            out[x] = luv_harris_response(a, m, c, k_q, scale);
+        std::fill(axx, axx + 3 * w, std::int64_t{0});
+        for (std::size_t i = 0; i < b; ++i) {
+            const std::int64_t wt = wts[i];
+            const std::int64_t* const row = buf.bring + ((y + i) % b) * 3 * w;
+            if constexpr (Box)
+                for (std::size_t x = 0; x < 3 * w; ++x) axx[x] += row[x];
+            else
+                for (std::size_t x = 0; x < 3 * w; ++x) axx[x] += wt * row[x];
         }
+        double* const out = table + y * w;
+        for (std::size_t x = 0; x < w; ++x) out[x] = luv_harris_response(axx[x], axy[x], ayy[x], k_q, scale);
     }
 }
 
@@ -257,12 +280,11 @@ void refresh_table(const Geometry& g, const std::uint8_t* tos, std::int16_t* hs,
 void LuvHarris::refresh() noexcept {
     if (params_.replicate_border) fill_border();
     const Geometry g = geometry(size_, params_);
-    if (params_.gradient == 5)
-        refresh_table<5>(g, tos_.data(), hs_.data(), hd_.data(), xx_.data(), bxx_.data(), block_weights_, k_q_, scale_,
-                         table_.data());
-    else
-        refresh_table<3>(g, tos_.data(), hs_.data(), hd_.data(), xx_.data(), bxx_.data(), block_weights_, k_q_, scale_,
-                         table_.data());
+    const RefreshBuffers buf{hs_.data(), hd_.data(), xx_.data(), bxx_.data(), bxx_.data() + 3 * g.w * static_cast<std::size_t>(params_.block)};
+    const bool box = !params_.gaussian_block;
+    auto* const run = params_.gradient == 5 ? (box ? refresh_table<5, true> : refresh_table<5, false>)
+                                            : (box ? refresh_table<3, true> : refresh_table<3, false>);
+    run(g, tos_.data(), buf, block_weights_, k_q_, scale_, table_.data());
     refreshed_ = true;
     ++refreshes_;
 }
