@@ -90,12 +90,15 @@ Harris::Harris(SensorSize size, HarrisParams params, int planes)
     // keys there. (Cells that never fired have key < 2^8, below every fired cell's, and
     // fired >= nl guarantees they are never taken.)
     int take = nl - newer;  // 1..m
-    if (m > kRankDirectly) {
-        // A crowded boundary bucket (ranking it directly costs m^2 compares; with an
-        // active window m often passes 30): split it once more, by the four bits of the
-        // age below its leading bit (ages in [2^(b-1), 2^b) -> 16 sub-buckets, monotone
-        // in age), light the newer sub-buckets, keep the boundary one's keys.
-        const int shift = boundary > 5 ? boundary - 5 : 0;
+    // A crowded boundary bucket (ranking it directly costs m^2 compares; with an active
+    // window m often passes 30, and an edge's burst puts them close in age): split it by
+    // the next four bits of the age below its leading bit (16 sub-buckets, monotone in
+    // age), light the newer sub-buckets, keep the boundary one's cells, and again with the
+    // next four bits, until few cells are left. Cells kept share every age bit above
+    // `shift`, so (age >> shift) & 15 stays monotone in age among them. Only cells that
+    // never fired share an age; they are ranked by key below.
+    int shift = boundary > 5 ? boundary - 5 : 0;
+    while (m > kRankDirectly) {
         std::uint8_t sub[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
         std::uint8_t sub_histogram[16] = {};
         for (int j = 0; j < m; ++j) {
@@ -113,6 +116,8 @@ Harris::Harris(SensorSize size, HarrisParams params, int planes)
             kept += sub[j] == sub_boundary;
         }
         m = kept;
+        if (shift == 0) break;
+        shift = shift > 4 ? shift - 4 : 0;
     }
     for (int j = 0; j < m; ++j) {
         int rank = 0;
