@@ -83,8 +83,14 @@ private:
     HarrisScorer scorer_;
     ArrivalSae sae_;
     int radius_;
+    bool avx512_;  // the 9x9 window's AVX-512 selection (harris_code_path())
     double score_ = kNoScore;
 };
 static_assert(ScoredDetector<Harris>);
+
+/// The code that selects a 9x9 window's newest pixels: "avx512" where the CPU runs it
+/// (the environment variable EVCORNER_HARRIS_PATH=portable forces the portable code),
+/// else "portable"; other windows always take the portable code. Same lit pixels either way.
+const char* harris_code_path() noexcept;
 
 }  // namespace evcorner
