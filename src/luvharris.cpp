@@ -15,6 +15,10 @@
 #include <stdexcept>
 #include <string>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 namespace evcorner {
 
 namespace {
@@ -80,8 +84,9 @@ struct BufferSizes {
 };
 BufferSizes buffer_sizes(SensorSize s, const LuvHarrisParams& p) {
     const Geometry g = geometry(s, p);
-    return {g.stride * (g.h + 2 * g.pad), g.w * g.h, static_cast<std::size_t>(p.gradient) * g.gw, 3 * g.gw,
-            3 * (static_cast<std::size_t>(p.block) + 1) * g.w};  // the block ring and one accumulator row
+    // The TOS with 16 bytes of slack for update_tos(); the block ring and one accumulator row.
+    return {g.stride * (g.h + 2 * g.pad) + 16, g.w * g.h, static_cast<std::size_t>(p.gradient) * g.gw, 3 * g.gw,
+            3 * (static_cast<std::size_t>(p.block) + 1) * g.w};
 }
 
 }  // namespace
@@ -139,6 +144,24 @@ void LuvHarris::update_tos(int x, int y) noexcept {
     const int x0 = std::max(x - r, 0), x1 = std::min(x + r, size_.width - 1);
     const int y0 = std::max(y - r, 0), y1 = std::min(y + r, size_.height - 1);
     const int drop = tos_drop_;
+#ifdef __SSE2__
+    // 16 bytes at a time: v >= drop (unsigned max(v, drop) == v) keeps v - 1, else 0;
+    // lanes outside x0..x1 are written back unchanged (the buffer has 16 bytes of slack).
+    const __m128i dropv = _mm_set1_epi8(static_cast<char>(drop));
+    const __m128i one = _mm_set1_epi8(1);
+    const __m128i lane = _mm_setr_epi8(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    for (int xs = x0; xs <= x1; xs += 16) {
+        const int n = std::min(16, x1 - xs + 1);
+        const __m128i inside = _mm_cmplt_epi8(lane, _mm_set1_epi8(static_cast<char>(n)));
+        for (int yy = y0; yy <= y1; ++yy) {
+            auto* const at = reinterpret_cast<__m128i*>(tos_.data() + index(xs, yy));
+            const __m128i v = _mm_loadu_si128(at);
+            const __m128i keep = _mm_cmpeq_epi8(_mm_max_epu8(v, dropv), v);
+            const __m128i next = _mm_and_si128(_mm_sub_epi8(v, one), keep);
+            _mm_storeu_si128(at, _mm_or_si128(_mm_and_si128(inside, next), _mm_andnot_si128(inside, v)));
+        }
+    }
+#else
     for (int yy = y0; yy <= y1; ++yy) {
         std::uint8_t* row = tos_.data() + index(0, yy);
         for (int xx = x0; xx <= x1; ++xx) {
@@ -146,6 +169,7 @@ void LuvHarris::update_tos(int x, int y) noexcept {
             row[xx] = static_cast<std::uint8_t>(v < drop ? 0 : v - 1);
         }
     }
+#endif
     tos_[index(x, y)] = 255;
 }
 
