@@ -53,8 +53,19 @@ public:
         check_event(e, limits());
         return process_unchecked(e);
     }
-    /// process() without the check: `e` must be accepted by limits().
+    /// process() without the check: `e` must be accepted by limits(). The same as
+    /// update_unchecked(e), then score_latest(e) compared with the threshold.
     bool process_unchecked(const Event& e) noexcept;
+
+    /// The two halves of process_unchecked(), for a caller that keeps the state current
+    /// with every event but scores only some (the eFAST -> Harris cascade):
+    /// update_unchecked() records `e` (accepted by limits()) and computes nothing; it
+    /// leaves last_score() as it was.
+    void update_unchecked(const Event& e) noexcept { sae_.update_unchecked(e); }
+    /// The score of `e`'s window as process() would compute it: `e` must be the latest
+    /// event given to update_unchecked(). kNoScore for a border event or too few pixels.
+    /// Changes nothing (last_score() included).
+    [[nodiscard]] double score_latest(const Event& e) const noexcept;
 
     /// Score of the latest processed event; kNoScore (NaN) for a border event, when fewer
     /// than nl distinct pixels of its polarity have fired in its window, or before any event.
@@ -66,12 +77,20 @@ public:
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
 
 private:
+    [[nodiscard]] double score_window(const Event& e) const noexcept;
+
     HarrisParams params_;
     HarrisScorer scorer_;
     ArrivalSae sae_;
     int radius_;
+    bool avx512_;  // the 9x9 window's AVX-512 selection (harris_code_path())
     double score_ = kNoScore;
 };
 static_assert(ScoredDetector<Harris>);
+
+/// The code that selects a 9x9 window's newest pixels: "avx512" where the CPU runs it
+/// (the environment variable EVCORNER_HARRIS_PATH=portable forces the portable code),
+/// else "portable"; other windows always take the portable code. Same lit pixels either way.
+const char* harris_code_path() noexcept;
 
 }  // namespace evcorner

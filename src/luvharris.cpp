@@ -1,0 +1,365 @@
+// luvHarris (docs/luvharris.md). Determinism: the table is integer arithmetic up to one
+// fixed conversion to double; the adaptive statistics are double arithmetic whose
+// operations must not be fused (an FMA rounds once where a multiply and an add round
+// twice, and a build for a CPU with FMA could otherwise differ from one without).
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#elif defined(__GNUC__)
+#pragma GCC optimize("fp-contract=off")
+#endif
+
+#include "evcorner/luvharris.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
+namespace evcorner {
+
+namespace {
+
+__extension__ typedef __int128 Int128;
+
+[[noreturn]] void bad(const std::string& what) { throw std::invalid_argument("luvHarris " + what); }
+
+LuvHarrisParams validated(const LuvHarrisParams& p) {
+    if (p.tos_size < 3 || p.tos_size > 31 || p.tos_size % 2 == 0)
+        bad("tos_size must be odd and within 3..31 (got " + std::to_string(p.tos_size) + ")");
+    if (p.tos_threshold < 0 || p.tos_size * p.tos_threshold > 254)
+        bad("tos_threshold must be within 0.." + std::to_string(254 / p.tos_size) + " (254 / tos_size) (got " +
+            std::to_string(p.tos_threshold) + ")");
+    if (p.gradient != 3 && p.gradient != 5) bad("gradient must be 3 or 5 (got " + std::to_string(p.gradient) + ")");
+    const int max_block = p.gaussian_block ? 9 : 15;
+    const int min_block = p.gaussian_block ? 3 : 1;
+    if (p.block < min_block || p.block > max_block || p.block % 2 == 0)
+        bad(std::string("block must be odd and within ") + std::to_string(min_block) + ".." + std::to_string(max_block) +
+            (p.gaussian_block ? " (gaussian)" : " (box)") + " (got " + std::to_string(p.block) + ")");
+    if (!(p.k >= 0.0 && p.k <= 0.25)) bad("k must be within 0..0.25");
+    if (p.refresh_us < 0 || p.refresh_us > LuvHarris::kMaxRefreshUs)
+        bad("refresh_us must be within 0.." + std::to_string(LuvHarris::kMaxRefreshUs) + " (got " +
+            std::to_string(p.refresh_us) + ")");
+    if (p.refresh_events < 0) bad("refresh_events must be >= 0 (got " + std::to_string(p.refresh_events) + ")");
+    if (p.refresh_us == 0 && p.refresh_events == 0)
+        bad("refresh_us and refresh_events cannot both be 0 (the table would never be computed)");
+    if (!std::isfinite(p.sigmas)) bad("sigmas must be a finite number");
+    if (!(p.alpha > 0.0 && p.alpha <= 1.0)) bad("alpha must be within (0, 1]");
+    if (!std::isfinite(p.threshold)) bad("threshold must be a finite number");
+    return p;
+}
+
+std::vector<std::int32_t> block_weights(const LuvHarrisParams& p) {
+    std::vector<std::int32_t> w(static_cast<std::size_t>(p.block), 1);
+    if (p.gaussian_block) {  // binomial: row block-1 of Pascal's triangle
+        for (int n = 1; n < p.block; ++n)
+            for (int j = n - 1; j >= 1; --j) w[static_cast<std::size_t>(j)] += w[static_cast<std::size_t>(j - 1)];
+    }
+    return w;
+}
+
+struct Geometry {
+    std::size_t w, h, hg, hb, pad, stride, gw, gh;
+};
+Geometry geometry(SensorSize s, const LuvHarrisParams& p) {
+    Geometry g{};
+    g.w = static_cast<std::size_t>(s.width);
+    g.h = static_cast<std::size_t>(s.height);
+    g.hg = static_cast<std::size_t>(p.gradient / 2);
+    g.hb = static_cast<std::size_t>(p.block / 2);
+    g.pad = g.hg + g.hb;
+    g.stride = g.w + 2 * g.pad;
+    g.gw = g.w + 2 * g.hb;  // gradient columns: the sensor and the block's reach
+    g.gh = g.h + 2 * g.hb;
+    return g;
+}
+
+// The ring buffers' sizes: gradient rows x gw for the two horizontal passes, three
+// product rows of gw, block rows x width for the three horizontal block sums.
+struct BufferSizes {
+    std::size_t tos, table, h_ring, products, b_ring;
+};
+BufferSizes buffer_sizes(SensorSize s, const LuvHarrisParams& p) {
+    const Geometry g = geometry(s, p);
+    // The TOS with 16 bytes of slack for update_tos(); the block ring and one accumulator row.
+    return {g.stride * (g.h + 2 * g.pad) + 16, g.w * g.h, static_cast<std::size_t>(p.gradient) * g.gw, 3 * g.gw,
+            3 * (static_cast<std::size_t>(p.block) + 1) * g.w};
+}
+
+}  // namespace
+
+double luv_harris_response(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t k_q, double scale) noexcept {
+    const Int128 det = static_cast<Int128>(a) * c - static_cast<Int128>(b) * b;
+    const std::int64_t tr = a + c;  // < 2^46 for every allowed parameter set
+    const Int128 r = det * 65536 - static_cast<Int128>(tr) * tr * k_q;  // |r| < 2^106 for every allowed parameter set
+    // To double: the high part (exact up to its own rounding) times 2^48 (exact), plus the
+    // low 48 bits (exact), rounded once; then the scale. The same on every IEEE machine.
+    const auto hi = static_cast<std::int64_t>(r >> 48);
+    const auto lo = static_cast<std::int64_t>(r & ((Int128{1} << 48) - 1));
+    const double value = static_cast<double>(hi) * 281474976710656.0 + static_cast<double>(lo);
+    return value * scale;
+}
+
+LuvHarris::LuvHarris(SensorSize size, const Params& params, int /*planes*/)
+    : params_(validated(params)),
+      size_(checked_sensor_size(size, "luvHarris")),
+      pad_(params_.gradient / 2 + params_.block / 2),
+      stride_(static_cast<std::size_t>(size_.width) + 2 * static_cast<std::size_t>(pad_)),
+      tos_drop_(255 - params_.tos_size * params_.tos_threshold),
+      k_q_(std::llround(params_.k * 65536.0)),
+      block_weights_(block_weights(params_)) {
+    // Gradients in TOS levels per pixel: the integer kernels give 128 (5x5) or 8 (3x3)
+    // times the slope of a ramp; the block sums weights adding up to ws per axis.
+    const double gn = params_.gradient == 5 ? 128.0 : 8.0;
+    double ws = 0;
+    for (const std::int32_t w : block_weights_) ws += w;
+    const double d = gn * gn * ws * ws;  // exact
+    scale_ = 1.0 / (d * d) / 65536.0;
+    const BufferSizes b = buffer_sizes(size_, params_);
+    tos_ = ZeroedArray<std::uint8_t>(b.tos);
+    table_ = ZeroedArray<double>(b.table);
+    hs_ = ZeroedArray<std::int16_t>(b.h_ring);
+    hd_ = ZeroedArray<std::int16_t>(b.h_ring);
+    xx_ = ZeroedArray<std::int32_t>(b.products);
+    bxx_ = ZeroedArray<std::int64_t>(b.b_ring);
+    until_count_refresh_ = params_.refresh_events;
+}
+
+std::uint64_t LuvHarris::state_bytes(SensorSize size, const Params& params, int /*planes*/) noexcept {
+    const BufferSizes b = buffer_sizes(size, params);
+    return b.tos + b.table * sizeof(double) + 2 * b.h_ring * sizeof(std::int16_t) +
+           b.products * sizeof(std::int32_t) + b.b_ring * sizeof(std::int64_t);
+}
+
+std::size_t LuvHarris::memory_bytes() const noexcept {
+    return tos_.size() + table_.size() * sizeof(double) + (hs_.size() + hd_.size()) * sizeof(std::int16_t) +
+           xx_.size() * sizeof(std::int32_t) + bxx_.size() * sizeof(std::int64_t);
+}
+
+void LuvHarris::update_tos(int x, int y) noexcept {
+    const int r = params_.tos_size / 2;
+    const int x0 = std::max(x - r, 0), x1 = std::min(x + r, size_.width - 1);
+    const int y0 = std::max(y - r, 0), y1 = std::min(y + r, size_.height - 1);
+    const int drop = tos_drop_;
+#ifdef __SSE2__
+    // 16 bytes at a time: v >= drop (unsigned max(v, drop) == v) keeps v - 1, else 0;
+    // lanes outside x0..x1 are written back unchanged (the buffer has 16 bytes of slack).
+    const __m128i dropv = _mm_set1_epi8(static_cast<char>(drop));
+    const __m128i one = _mm_set1_epi8(1);
+    const __m128i lane = _mm_setr_epi8(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    for (int xs = x0; xs <= x1; xs += 16) {
+        const int n = std::min(16, x1 - xs + 1);
+        const __m128i inside = _mm_cmplt_epi8(lane, _mm_set1_epi8(static_cast<char>(n)));
+        for (int yy = y0; yy <= y1; ++yy) {
+            auto* const at = reinterpret_cast<__m128i*>(tos_.data() + index(xs, yy));
+            const __m128i v = _mm_loadu_si128(at);
+            const __m128i keep = _mm_cmpeq_epi8(_mm_max_epu8(v, dropv), v);
+            const __m128i next = _mm_and_si128(_mm_sub_epi8(v, one), keep);
+            _mm_storeu_si128(at, _mm_or_si128(_mm_and_si128(inside, next), _mm_andnot_si128(inside, v)));
+        }
+    }
+#else
+    for (int yy = y0; yy <= y1; ++yy) {
+        std::uint8_t* row = tos_.data() + index(0, yy);
+        for (int xx = x0; xx <= x1; ++xx) {
+            const int v = row[xx];
+            row[xx] = static_cast<std::uint8_t>(v < drop ? 0 : v - 1);
+        }
+    }
+#endif
+    tos_[index(x, y)] = 255;
+}
+
+void LuvHarris::fill_border() noexcept {
+    const std::size_t p = static_cast<std::size_t>(pad_), w = static_cast<std::size_t>(size_.width),
+                      h = static_cast<std::size_t>(size_.height);
+    std::uint8_t* t = tos_.data();
+    for (std::size_t y = p; y < p + h; ++y) {
+        std::uint8_t* row = t + y * stride_;
+        std::fill(row, row + p, row[p]);
+        std::fill(row + p + w, row + stride_, row[p + w - 1]);
+    }
+    for (std::size_t y = 0; y < p; ++y) {
+        std::copy(t + p * stride_, t + (p + 1) * stride_, t + y * stride_);
+        std::copy(t + (p + h - 1) * stride_, t + (p + h) * stride_, t + (p + h + y) * stride_);
+    }
+}
+
+namespace {
+
+// The table from the TOS, row by row through ring buffers (all in cache): for product
+// row q (rows -hb..h+hb of the sensor), the horizontal passes of TOS row q+g-1, the
+// vertical pass giving Ix, Iy and their products over gw columns, the horizontal block
+// sums into the block ring; then, once b rows are there, the vertical block sums and the
+// response of sensor row q-b+1. Every inner loop runs along a row with compile-time taps
+// or a tap outside it, so that the compiler vectorises it.
+template <int G>
+struct Taps;
+template <>
+struct Taps<5> {
+    static constexpr int smooth[5] = {1, 4, 6, 4, 1};
+    static constexpr int deriv[5] = {1, 2, 0, -2, -1};
+};
+template <>
+struct Taps<3> {
+    static constexpr int smooth[3] = {1, 2, 1};
+    static constexpr int deriv[3] = {1, 0, -1};
+};
+
+struct RefreshBuffers {
+    std::int16_t* hs;     // G rows x gw
+    std::int16_t* hd;     // G rows x gw
+    std::int32_t* prod;   // 3 x gw
+    std::int64_t* bring;  // b rows x 3 x w
+    std::int64_t* acc;    // 3 x w
+};
+
+// Box: every block weight is 1 (adds only: a 64-bit multiply has no SSE2 instruction).
+template <int G, bool Box>
+void refresh_table(const Geometry& g, const std::uint8_t* tos, const RefreshBuffers& buf,
+                   const std::vector<std::int32_t>& wts, std::int64_t k_q, double scale, double* table) noexcept {
+    constexpr const int* smooth = Taps<G>::smooth;
+    constexpr const int* deriv = Taps<G>::deriv;
+    const std::size_t gw = g.gw, w = g.w, b = wts.size();
+
+    auto horizontal = [&](std::size_t r) {  // TOS row r (padded coordinates) -> ring slot r % G
+        const std::uint8_t* in = tos + r * g.stride;
+        std::int16_t* s = buf.hs + (r % G) * gw;
+        std::int16_t* d = buf.hd + (r % G) * gw;
+        for (std::size_t c = 0; c < gw; ++c) {
+            int sv = 0, dv = 0;
+            for (int j = 0; j < G; ++j) {
+                sv += smooth[j] * in[c + static_cast<std::size_t>(j)];
+                dv += deriv[j] * in[c + static_cast<std::size_t>(j)];
+            }
+            s[c] = static_cast<std::int16_t>(sv);
+            d[c] = static_cast<std::int16_t>(dv);
+        }
+    };
+    for (std::size_t r = 0; r + 1 < G; ++r) horizontal(r);
+
+    std::int32_t* const pxx = buf.prod;
+    std::int32_t* const pxy = buf.prod + gw;
+    std::int32_t* const pyy = buf.prod + 2 * gw;
+    std::int64_t* const axx = buf.acc;
+    std::int64_t* const axy = buf.acc + w;
+    std::int64_t* const ayy = buf.acc + 2 * w;
+    for (std::size_t q = 0; q < g.gh; ++q) {
+        horizontal(q + G - 1);
+        const std::int16_t* sr[G];
+        const std::int16_t* dr[G];
+        for (int i = 0; i < G; ++i) {
+            sr[i] = buf.hs + ((q + static_cast<std::size_t>(i)) % G) * gw;
+            dr[i] = buf.hd + ((q + static_cast<std::size_t>(i)) % G) * gw;
+        }
+        for (std::size_t c = 0; c < gw; ++c) {
+            int ix = 0, iy = 0;
+            for (int i = 0; i < G; ++i) {
+                ix += smooth[i] * dr[i][c];
+                iy += deriv[i] * sr[i][c];
+            }
+            pxx[c] = ix * ix;
+            pxy[c] = ix * iy;
+            pyy[c] = iy * iy;
+        }
+        std::int64_t* const bxx = buf.bring + (q % b) * 3 * w;
+        std::int64_t* const bxy = bxx + w;
+        std::int64_t* const byy = bxy + w;
+        std::fill(bxx, bxx + 3 * w, std::int64_t{0});
+        for (std::size_t j = 0; j < b; ++j) {
+            const std::int64_t wt = wts[j];
+            for (std::size_t x = 0; x < w; ++x) {
+                if constexpr (Box) {
+                    bxx[x] += pxx[x + j];
+                    bxy[x] += pxy[x + j];
+                    byy[x] += pyy[x + j];
+                } else {
+                    bxx[x] += wt * pxx[x + j];
+                    bxy[x] += wt * pxy[x + j];
+                    byy[x] += wt * pyy[x + j];
+                }
+            }
+        }
+        if (q + 1 < b) continue;
+        const std::size_t y = q + 1 - b;  // sensor row: block rows y..y+b-1 of the ring
+        std::fill(axx, axx + 3 * w, std::int64_t{0});
+        for (std::size_t i = 0; i < b; ++i) {
+            const std::int64_t wt = wts[i];
+            const std::int64_t* const row = buf.bring + ((y + i) % b) * 3 * w;
+            if constexpr (Box)
+                for (std::size_t x = 0; x < 3 * w; ++x) axx[x] += row[x];
+            else
+                for (std::size_t x = 0; x < 3 * w; ++x) axx[x] += wt * row[x];
+        }
+        double* const out = table + y * w;
+        for (std::size_t x = 0; x < w; ++x) out[x] = luv_harris_response(axx[x], axy[x], ayy[x], k_q, scale);
+    }
+}
+
+}  // namespace
+
+void LuvHarris::refresh() noexcept {
+    if (params_.replicate_border) fill_border();
+    const Geometry g = geometry(size_, params_);
+    const RefreshBuffers buf{hs_.data(), hd_.data(), xx_.data(), bxx_.data(), bxx_.data() + 3 * g.w * static_cast<std::size_t>(params_.block)};
+    const bool box = !params_.gaussian_block;
+    auto* const run = params_.gradient == 5 ? (box ? refresh_table<5, true> : refresh_table<5, false>)
+                                            : (box ? refresh_table<3, true> : refresh_table<3, false>);
+    run(g, tos_.data(), buf, block_weights_, k_q_, scale_, table_.data());
+    refreshed_ = true;
+    ++refreshes_;
+}
+
+bool LuvHarris::process_unchecked(const Event& e) noexcept {
+    // 1. A refresh point due before this event: the time rule (t0 + n refresh_us, t0 the
+    // first event's time; one refresh however many points passed since the last event)
+    // and/or the count rule (before events refresh_events, 2 refresh_events, ...).
+    bool due = false;
+    if (!started_) {
+        started_ = true;
+        t0_ = e.t;
+        next_t_ = params_.refresh_us > 0 ? e.t + params_.refresh_us : kMaxTime;
+    } else if (params_.refresh_us > 0 && e.t >= next_t_) {
+        due = true;
+        next_t_ = e.t - (e.t - t0_) % params_.refresh_us + params_.refresh_us;
+    }
+    if (params_.refresh_events > 0) {
+        if (until_count_refresh_ == 0) {  // starts at refresh_events: never before event 0
+            due = true;
+            until_count_refresh_ = params_.refresh_events;
+        }
+        --until_count_refresh_;
+    }
+    if (due) refresh();
+
+    // 2. The surface.
+    update_tos(e.x, e.y);
+
+    // 3. The look-up and the threshold.
+    if (!refreshed_) {
+        score_ = kNoScore;
+        return false;
+    }
+    const double v = table(e.x, e.y);
+    score_ = v;
+    if (!params_.adaptive) return v > params_.threshold;
+    // Adaptive: compared with the statistics of the values looked up before (none: no
+    // corner), then included: exponentially weighted mean and variance, weight alpha.
+    const bool corner = stats_n_ > 0 && v > mean_ + params_.sigmas * std::sqrt(var_);
+    if (stats_n_ == 0) {
+        mean_ = v;
+        var_ = 0.0;
+    } else {
+        const double diff = v - mean_;
+        const double incr = params_.alpha * diff;
+        mean_ = mean_ + incr;
+        var_ = (1.0 - params_.alpha) * (var_ + diff * incr);
+    }
+    ++stats_n_;
+    return corner;
+}
+
+}  // namespace evcorner
