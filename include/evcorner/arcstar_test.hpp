@@ -1,0 +1,108 @@
+#pragma once
+// The two per-event tests of Arc* (Alzugaray and Chli, "Asynchronous Corner Detection and
+// Tracking for Event Cameras in Real Time", RA-L 2018), shared by ArcStar (arcstar.hpp) and
+// FA-Harris (fa_harris.hpp), which uses Arc* as its candidate stage. docs/arcstar.md gives
+// the exact definitions; both work on stored SAE values (sae.hpp: t + Sae::kBias, 0 = never
+// fired), whose order is the order of the times.
+//
+// - The filter: an event passes iff its pixel never fired with its polarity, or the
+//   latest event there of its polarity is more than `window` us older, or the pixel fired
+//   with the other polarity since. The caller records the event as the pixel's latest in
+//   every case.
+// - The arc test on one circle: grow an arc from the first newest pixel, taking the
+//   newer of the two frontier pixels each time (ties: counter-clockwise), Lmin-1 times
+//   unconditionally, then on to the whole circle, where a frontier pixel at least as new
+//   as the arc's oldest (seg) extends the arc to everything visited so far. The circle
+//   passes iff the final size is within Lmin..Lmax or (unless minority_only) within
+//   N-Lmax..N-Lmin.
+
+#include <cstdint>
+
+#include "evcorner/arc_test.hpp"
+#include "evcorner/sae.hpp"
+
+namespace evcorner {
+
+/// The latest (unfiltered) event times of one pixel, one per polarity, stored form.
+/// Interleaved so that the filter's two reads and one write touch one 16-byte cell.
+struct ArcStarLatest {
+    std::int64_t t[2];
+};
+
+/// The Arc* filter on stored values: `st` the event's stored time, `own` and `other` the
+/// pixel's latest stored times of the event's polarity and of the other one (0 = never).
+/// `zero_init`: the authors' zero-initialised state, where a pixel that never fired reads
+/// as time 0 rather than as never (so an event at t <= window there is rejected).
+[[nodiscard]] inline bool arcstar_filter_passes(std::int64_t st, std::int64_t own, std::int64_t other,
+                                                std::int64_t window, bool zero_init) noexcept {
+    const std::int64_t zero = zero_init ? Sae::kBias : 0;  // what a never-fired cell reads as
+    own = detail::select(own == 0, zero, own);
+    other = detail::select(other == 0, zero, other);
+    // Non-short-circuit: one branch-free test.
+    return (own == 0) | (st - own > window) | (other > own);
+}
+
+/// Whether an Arc* arc of final `size` passes on a circle of N pixels.
+template <int N, int Lmin, int Lmax>
+[[nodiscard]] inline bool arcstar_size_passes(int size, bool minority_only) noexcept {
+    return (size <= Lmax) | (!minority_only & (size >= N - Lmax) & (size <= N - Lmin));
+}
+
+/// The final arc size of the Arc* growth on the circle t[0..N) given twice (t[k + N] ==
+/// t[k]) from its first newest pixel `k` (the first index of the largest value).
+/// Branch-free; each frontier's next value is loaded one step ahead, so that the chain
+/// from one step's choice to the next is a compare and a conditional move, not a load.
+template <int N, int Lmin, int Lmax>
+[[nodiscard]] inline int arcstar_arc_size(const std::int64_t* t, int k) noexcept {
+    static_assert(2 <= Lmin && Lmin <= Lmax && Lmax < N);
+    using detail::min;
+    using detail::select;
+    // Frontiers as indices into the doubled circle: cw from k+1 up, ccw from k-1+N down;
+    // N-1 steps in all keep both within [0, 2N).
+    int cw = k + 1;
+    int ccw = k - 1 + N;
+    std::int64_t vc = t[cw], vd = t[ccw];           // the frontier values
+    std::int64_t nc = t[cw + 1], nd = t[ccw - 1];   // the values one step beyond them
+    std::int64_t min_cw = vc, min_ccw = vd;         // smallest visited per side, frontier included
+    std::int64_t seg = t[k];
+    int size = Lmin;
+#pragma GCC unroll 32
+    for (int it = 1; it < N; ++it) {
+        const bool go_cw = vc > vd;
+        const std::int64_t v = go_cw ? vc : vd;     // the value taken (the larger one)
+        const std::int64_t side_min = select(go_cw, min_cw, min_ccw);
+        if (it < Lmin) {
+            seg = min(seg, side_min);
+        } else {
+            const bool grow = v >= seg;
+            size = select(grow, it + 1, size);
+            seg = select(grow, min(seg, side_min), seg);
+        }
+        // Advance the chosen side; its new frontier is the value loaded ahead.
+        cw += go_cw;
+        ccw -= !go_cw;
+        vc = select(go_cw, nc, vc);
+        vd = select(go_cw, vd, nd);
+        min_cw = min(min_cw, vc);
+        min_ccw = min(min_ccw, vd);
+        if (it + 1 < N) {
+            nc = t[cw + 1];
+            nd = t[ccw - 1];
+        }
+    }
+    return size;
+}
+
+/// Gathers the circle around `centre` (pixel k at centre[offset(k)]) and runs the Arc*
+/// arc test on it; `Search` finds the first newest pixel (arc_test.hpp; all of them
+/// return the first index of the largest value).
+template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
+[[nodiscard]] inline bool arcstar_circle_passes(const std::int64_t* centre, Offset offset, bool minority_only) noexcept {
+    std::int64_t t[2 * N];
+#pragma GCC unroll 32
+    for (int k = 0; k < N; ++k) t[k] = centre[offset(k)];
+    const int newest = Search::template newest<N>(t);
+    return arcstar_size_passes<N, Lmin, Lmax>(arcstar_arc_size<N, Lmin, Lmax>(t, newest), minority_only);
+}
+
+}  // namespace evcorner
