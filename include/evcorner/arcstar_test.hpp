@@ -93,6 +93,127 @@ template <int N, int Lmin, int Lmax>
     return size;
 }
 
+/// An exact shortcut for the commonest outcome on real data: whether the Arc* growth from
+/// `k` (as in arcstar_arc_size) surely ends with size N, told from bit masks without
+/// the growth. Proof (docs/arcstar.md): the growth consumes pixels in decreasing order of
+/// their side's running minimum ("key"; ties counter-clockwise first), so with m the
+/// circle's oldest value, held by at least two pixels besides k, the first of them is
+/// consumed at step g = i1 + j1 - 1 (i1, j1: their distances from k clockwise and
+/// counter-clockwise) and every pixel after it has key m. If g < Lmin, the forced growth
+/// takes seg down to m and every later pixel grows the arc; otherwise any later pixel (all
+/// lie on the far arc between those two) at least as new as `bound` >= seg grows it, seg
+/// becomes m and so does every pixel after. Either way the last step grows: size N.
+/// `bound`: the best oldest of the Lmin-windows through k, an upper bound of seg after the
+/// forced growth. False means "not known", not "not N".
+namespace detail {
+// Bit k set where t[k] (k < N) equals m, and where t[k] >= bound: the masks of
+// arcstar_surely_full, in circle order (not yet rotated). Portable form.
+template <int N>
+struct ArcMasks {
+    static void get(const std::int64_t* t, std::int64_t m, std::int64_t bound, std::uint32_t& eq,
+                    std::uint32_t& ge) noexcept {
+        eq = 0;
+        ge = 0;
+#pragma GCC unroll 32
+        for (int k = 0; k < N; ++k) {
+            eq |= static_cast<std::uint32_t>(t[k] == m) << k;
+            ge |= static_cast<std::uint32_t>(t[k] >= bound) << k;
+        }
+    }
+    static std::int64_t oldest(const std::int64_t* t) noexcept {
+        std::int64_t m = t[0];
+#pragma GCC unroll 32
+        for (int k = 1; k < N; ++k) m = min(m, t[k]);
+        return m;
+    }
+};
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+// The same four lanes at a time (for code compiled for AVX2 only).
+template <int N>
+struct ArcMasksAvx2 {
+    static_assert(N % 4 == 0);
+    [[gnu::target("avx2")]] static void get(const std::int64_t* t, std::int64_t m,
+                                                                        std::int64_t bound, std::uint32_t& eq,
+                                                                        std::uint32_t& ge) noexcept {
+        const __m256i vm = _mm256_set1_epi64x(m);
+        const __m256i vb = _mm256_set1_epi64x(bound);
+        eq = 0;
+        ge = 0;
+        for (int i = 0; i < N / 4; ++i) {
+            const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 4 * i));
+            eq |= static_cast<std::uint32_t>(_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(v, vm))))
+                  << (4 * i);
+            // t >= bound  <=>  !(bound > t)
+            ge |= static_cast<std::uint32_t>(~_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpgt_epi64(vb, v))) & 15)
+                  << (4 * i);
+        }
+    }
+    [[gnu::target("avx2")]] static std::int64_t oldest(const std::int64_t* t) noexcept {
+        __m256i mn = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t));
+        for (int i = 1; i < N / 4; ++i) {
+            const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 4 * i));
+            mn = _mm256_blendv_epi8(mn, v, _mm256_cmpgt_epi64(mn, v));
+        }
+        mn = _mm256_blendv_epi8(mn, _mm256_permute4x64_epi64(mn, 0x4E),
+                                _mm256_cmpgt_epi64(mn, _mm256_permute4x64_epi64(mn, 0x4E)));
+        mn = _mm256_blendv_epi8(mn, _mm256_shuffle_epi32(mn, 0x4E), _mm256_cmpgt_epi64(mn, _mm256_shuffle_epi32(mn, 0x4E)));
+        return _mm256_extract_epi64(mn, 0);
+    }
+};
+#endif
+template <class Search, int N>
+struct ArcMasksFor {
+    using type = ArcMasks<N>;
+};
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+template <int N>
+struct ArcMasksFor<Avx2Search, N> {
+    using type = ArcMasksAvx2<N>;
+};
+#endif
+}  // namespace detail
+
+/// An exact shortcut for the commonest outcome on real data: whether the Arc* growth from
+/// `k` (as in arcstar_arc_size) surely ends with size N, told from bit masks without
+/// the growth. Proof (docs/arcstar.md): the growth consumes pixels in decreasing order of
+/// their side's running minimum ("key"; ties counter-clockwise first), so with m the
+/// circle's oldest value, held by at least two pixels besides k, the first of them is
+/// consumed at step g = i1 + j1 - 1 (i1, j1: their distances from k clockwise and
+/// counter-clockwise) and every pixel after it has key m. If g < Lmin, the forced growth
+/// takes seg down to m and every later pixel grows the arc; otherwise any later pixel (all
+/// lie on the far arc between those two) at least as new as `bound` >= seg grows it, seg
+/// becomes m and so does every pixel after. Either way the last step grows: size N.
+/// `bound`: the best oldest of the Lmin-windows through k, an upper bound of seg after the
+/// forced growth. False means "not known", not "not N". `t` is the circle twice.
+template <int N, int Lmin, class Search = ScalarSearch>
+[[nodiscard]] inline bool arcstar_surely_full(const std::int64_t* t, int k) noexcept {
+    using detail::max;
+    using detail::min;
+    using Masks = typename detail::ArcMasksFor<Search, N>::type;
+    const std::int64_t m = Masks::oldest(t);
+    const int c = k + N * static_cast<int>(k < Lmin);  // a copy of k with +-(Lmin-1) inside [0, 2N)
+    std::int64_t bound = INT64_MIN;
+#pragma GCC unroll 8
+    for (int s = 0; s < Lmin; ++s) {
+        std::int64_t w = t[c - s];
+        for (int q = 1; q < Lmin; ++q) w = min(w, t[c - s + q]);
+        bound = max(bound, w);
+    }
+    std::uint32_t eq, ge;
+    Masks::get(t, m, bound, eq, ge);
+    // Rotate so that bit j is the pixel j steps clockwise from k; drop k itself.
+    constexpr std::uint32_t kAll = (std::uint32_t{1} << N) - 1;
+    const auto rot = [k](std::uint32_t x) {
+        return ((x >> k) | (x << ((N - k) & 31))) & kAll;
+    };
+    const std::uint32_t oldest = rot(eq) & ~std::uint32_t{1};
+    if (__builtin_popcount(oldest) < 2) return false;
+    const int i1 = __builtin_ctz(oldest);
+    const int hi = 31 - __builtin_clz(oldest);  // j1 = N - hi
+    const std::uint32_t far = ((std::uint32_t{2} << hi) - 1) & ~((std::uint32_t{1} << i1) - 1);
+    return (i1 + (N - hi) <= Lmin) | ((rot(ge) & far) != 0);
+}
+
 /// Gathers the circle around `centre` (pixel k at centre[offset(k)]) and runs the Arc*
 /// arc test on it; `Search` finds the first newest pixel (arc_test.hpp; all of them
 /// return the first index of the largest value).
@@ -102,6 +223,7 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
 #pragma GCC unroll 32
     for (int k = 0; k < N; ++k) t[k] = centre[offset(k)];
     const int newest = Search::template newest<N>(t);
+    if (arcstar_surely_full<N, Lmin, Search>(t, newest)) return arcstar_size_passes<N, Lmin, Lmax>(N, minority_only);
     return arcstar_size_passes<N, Lmin, Lmax>(arcstar_arc_size<N, Lmin, Lmax>(t, newest), minority_only);
 }
 

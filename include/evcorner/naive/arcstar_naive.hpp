@@ -17,9 +17,9 @@ namespace evcorner::naive {
 
 inline constexpr std::int64_t kNeverNaive = INT64_MIN;
 
-/// The Arc* arc test on one circle T[0..N) (docs/arcstar.md), step by step.
+/// The final arc size of the Arc* growth on one circle T[0..N) (docs/arcstar.md), step by step.
 template <int N>
-bool arcstar_arc_naive(const std::array<std::int64_t, N>& T, int lmin, int lmax, bool minority_only) {
+int arcstar_size_naive(const std::array<std::int64_t, N>& T, int lmin) {
     auto mod = [](int i) { return ((i % N) + N) % N; };
     int kstar = 0;
     for (int k = 1; k < N; ++k)
@@ -56,6 +56,14 @@ bool arcstar_arc_naive(const std::array<std::int64_t, N>& T, int lmin, int lmax,
             if (T[ccw] < min_ccw) min_ccw = T[ccw];
         }
     }
+    return size;
+}
+
+/// The Arc* arc test on one circle: the size within lmin..lmax, or (unless
+/// minority_only) within N-lmax..N-lmin.
+template <int N>
+bool arcstar_arc_naive(const std::array<std::int64_t, N>& T, int lmin, int lmax, bool minority_only) {
+    const int size = arcstar_size_naive<N>(T, lmin);
     if (size <= lmax) return true;
     if (minority_only) return false;
     return size >= N - lmax && size <= N - lmin;
@@ -118,15 +126,20 @@ public:
     explicit ArcStarNaive(SensorSize size, const ArcStarParams& params = {}) : s_(size, params) {}
 
     bool process(const Event& e) {
-        if (!s_.filter(e)) return false;
+        passed_ = s_.filter(e);
+        if (!passed_) return false;
         s_.write_filtered(e);
         const SensorSize z = s_.size();
         if (e.x < 4 || e.x >= z.width - 4 || e.y < 4 || e.y >= z.height - 4) return false;
         return s_.arc_test(e.p, e.x, e.y);
     }
 
+    /// Whether the latest event passed the filter.
+    bool last_passed() const { return passed_; }
+
 private:
     ArcStarStateNaive s_;
+    bool passed_ = false;
 };
 
 }  // namespace evcorner::naive
