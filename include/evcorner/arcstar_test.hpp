@@ -42,6 +42,21 @@ struct ArcStarLatest {
     return (own == 0) | (st - own > window) | (other > own);
 }
 
+namespace detail {
+/// c ? a : b as a conditional move: the compiler turns some such choices into branches,
+/// and on the arc growth's data they mispredict.
+template <class T>
+inline T cmov(bool c, T a, T b) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+    const unsigned flag = c;
+    __asm__("test %[f], %[f]\n\tcmovne %[a], %[b]" : [b] "+r"(b) : [a] "r"(a), [f] "r"(flag) : "cc");
+    return b;
+#else
+    return c ? a : b;
+#endif
+}
+}  // namespace detail
+
 /// Whether an Arc* arc of final `size` passes on a circle of N pixels.
 template <int N, int Lmin, int Lmax>
 [[nodiscard]] inline bool arcstar_size_passes(int size, bool minority_only) noexcept {
@@ -56,7 +71,6 @@ template <int N, int Lmin, int Lmax>
 [[nodiscard]] inline int arcstar_arc_size(const std::int64_t* t, int k) noexcept {
     static_assert(2 <= Lmin && Lmin <= Lmax && Lmax < N);
     using detail::min;
-    using detail::select;
     // Frontiers as indices into the doubled circle: cw from k+1 up, ccw from k-1+N down;
     // N-1 steps in all keep both within [0, 2N).
     int cw = k + 1;
@@ -66,25 +80,28 @@ template <int N, int Lmin, int Lmax>
     std::int64_t min_cw = vc, min_ccw = vd;         // smallest visited per side, frontier included
     std::int64_t seg = t[k];
     int size = Lmin;
+    // Every choice a conditional move (detail::cmov): one instruction where the mask form
+    // of detail::select costs four, and never a branch on the data.
 #pragma GCC unroll 32
     for (int it = 1; it < N; ++it) {
         const bool go_cw = vc > vd;
-        const std::int64_t v = go_cw ? vc : vd;     // the value taken (the larger one)
-        const std::int64_t side_min = select(go_cw, min_cw, min_ccw);
+        const std::int64_t v = detail::cmov(go_cw, vc, vd);  // the value taken (the larger one)
+        const std::int64_t side_min = detail::cmov(go_cw, min_cw, min_ccw);
         if (it < Lmin) {
-            seg = min(seg, side_min);
+            seg = detail::cmov(seg < side_min, seg, side_min);
         } else {
             const bool grow = v >= seg;
-            size = select(grow, it + 1, size);
-            seg = select(grow, min(seg, side_min), seg);
+            size = detail::cmov(grow, it + 1, size);
+            const std::int64_t grown = detail::cmov(seg < side_min, seg, side_min);
+            seg = detail::cmov(grow, grown, seg);
         }
         // Advance the chosen side; its new frontier is the value loaded ahead.
         cw += go_cw;
         ccw -= !go_cw;
-        vc = select(go_cw, nc, vc);
-        vd = select(go_cw, vd, nd);
-        min_cw = min(min_cw, vc);
-        min_ccw = min(min_ccw, vd);
+        vc = detail::cmov(go_cw, nc, vc);
+        vd = detail::cmov(go_cw, vd, nd);
+        min_cw = detail::cmov(min_cw < vc, min_cw, vc);
+        min_ccw = detail::cmov(min_ccw < vd, min_ccw, vd);
         if (it + 1 < N) {
             nc = t[cw + 1];
             nd = t[ccw - 1];
