@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdlib>
+#include <cstring>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -49,7 +51,8 @@ std::uint64_t FaHarris::state_bytes(SensorSize size, const Params& params, int) 
     return static_cast<std::uint64_t>(size.pixels()) * sizeof(ArcStarLatest) + 2 * framed * 2 * sizeof(std::int64_t);
 }
 
-bool FaHarris::process_unchecked(const Event& e) noexcept {
+template <class Search>
+bool FaHarris::process_with(const Event& e) noexcept {
     score_ = kNoScore;
     // (1) Border first: such an event changes no state at all.
     if (e.x < kCircleMargin || e.x >= size_.width - kCircleMargin || e.y < kCircleMargin ||
@@ -70,9 +73,9 @@ bool FaHarris::process_unchecked(const Event& e) noexcept {
     // (3) The Arc* candidate test.
     const std::ptrdiff_t w = static_cast<std::ptrdiff_t>(stride_);
     const bool minority = params_.minority_only;
-    if (!arcstar_circle_passes<kCircle3.size(), ArcStar::kArc3Min, ArcStar::kArc3Max>(
+    if (!arcstar_circle_passes<kCircle3.size(), ArcStar::kArc3Min, ArcStar::kArc3Max, Search>(
             centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority) ||
-        !arcstar_circle_passes<kCircle4.size(), ArcStar::kArc4Min, ArcStar::kArc4Max>(
+        !arcstar_circle_passes<kCircle4.size(), ArcStar::kArc4Min, ArcStar::kArc4Max, Search>(
             centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority))
         return false;
     // (4) Harris on the nl newest filtered pixels of the window.
@@ -115,34 +118,92 @@ double FaHarris::refine(int p, int x, int y) const noexcept {
         ++boundary;
     }
     std::uint16_t rows[HarrisScorer::kMaxWindow];
-    int cand[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];  // boundary cells
+    // The boundary bucket's cells with their (time, arrival) keys, gathered in the same pass.
+    struct Key {
+        std::int64_t t;
+        std::uint64_t q;
+        int row, col;
+    };
+    Key keys[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
     int m = 0;
     for (int row = 0, i = 0; row < w; ++row) {
         unsigned lit = 0;
+        const std::int64_t* const tr = times + static_cast<std::size_t>(row) * stride_;
+        const std::uint64_t* const qr = seqs + static_cast<std::size_t>(row) * stride_;
         for (int c = 0; c < w; ++c, ++i) {
             lit |= static_cast<unsigned>(bucket[i] < boundary) << c;
-            cand[m] = i;
+            keys[m] = {tr[c], qr[c], row, c};
             m += bucket[i] == boundary;
         }
         rows[row] = static_cast<std::uint16_t>(lit);
     }
-    // The `take` newest of the boundary bucket: those with fewer than `take` newer cells
-    // there, newer = later time, or the same time and a later arrival (arrival numbers are
-    // unique among fired cells; never-fired cells, time 0 and arrival 0, are the oldest and
-    // fired >= nl keeps them out).
-    const int take = nl - newer;
-    auto at = [&](int i, auto* base) { return base[static_cast<std::size_t>(i / w) * stride_ + static_cast<std::size_t>(i % w)]; };
-    for (int j = 0; j < m; ++j) {
-        const std::int64_t tj = at(cand[j], times);
-        const std::uint64_t qj = at(cand[j], seqs);
-        int rank = 0;
-        for (int k = 0; k < m; ++k) {
-            const std::int64_t tk = at(cand[k], times);
-            rank += (tk > tj) | ((tk == tj) & (at(cand[k], seqs) > qj));
-        }
-        rows[cand[j] / w] |= static_cast<std::uint16_t>(static_cast<unsigned>(rank < take) << (cand[j] % w));
+    // Light the `take` newest of the boundary bucket: newer = later time, or the same time
+    // and a later arrival (arrival numbers are unique among fired cells; never-fired cells,
+    // time 0 and arrival 0, are the oldest, and fired >= nl keeps them out).
+    const int take = nl - newer;  // 1..m
+    if (take < m) {
+        std::nth_element(keys, keys + (take - 1), keys + m, [](const Key& a, const Key& b) {
+            return a.t != b.t ? a.t > b.t : a.q > b.q;
+        });
     }
+    for (int j = 0; j < take; ++j) rows[keys[j].row] |= static_cast<std::uint16_t>(1u << keys[j].col);
     return scorer_.score(rows);
+}
+
+bool FaHarris::process_unchecked(const Event& e) noexcept { return process_with<ScalarSearch>(e); }
+
+struct FaHarrisLoops {
+    template <class Search>
+    static std::size_t run(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+        std::size_t corners = 0;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            const bool c = det.process_with<Search>(events[i]);
+            is_corner[i] = static_cast<std::uint8_t>(c);
+            corners += c;
+        }
+        return corners;
+    }
+};
+
+namespace {
+
+std::size_t run_portable(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    return FaHarrisLoops::run<ScalarSearch>(det, events, is_corner);
+}
+
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+// flatten: the per-event path (refine() aside, a call) compiled for AVX2 here only.
+[[gnu::target("avx2"), gnu::flatten]] std::size_t run_avx2(FaHarris& det, std::span<const Event> events,
+                                                            std::span<std::uint8_t> is_corner) noexcept {
+    return FaHarrisLoops::run<Avx2Search>(det, events, is_corner);
+}
+#endif
+
+using Loop = std::size_t (*)(FaHarris&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
+
+Loop loop() noexcept {
+    static const Loop l = [] {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        __builtin_cpu_init();
+        const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
+        if (__builtin_cpu_supports("avx2") && !(forced != nullptr && std::strcmp(forced, "portable") == 0))
+            return static_cast<Loop>(run_avx2);
+#endif
+        return static_cast<Loop>(run_portable);
+    }();
+    return l;
+}
+
+}  // namespace
+
+std::size_t detect(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
+    detail::check_flags(events.size(), is_corner.size(), "detect");
+    check_events(events, det.limits());
+    return loop()(det, events, is_corner);
+}
+
+std::size_t detect_unchecked(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    return loop()(det, events, is_corner);
 }
 
 }  // namespace evcorner

@@ -53,11 +53,14 @@ TEST_P(FaHarrisVsOracle, SameCornersAndScoresEventForEvent) {
         for (std::uint64_t seed = 1; seed <= 3; ++seed) {
             const auto ev = test::arcstar_stream(s, n, seed * 104729 + static_cast<std::uint64_t>(s.height), v.step_us,
                                                  v.pause_us);
-            FaHarris fast(s, v.params);
+            FaHarris fast(s, v.params), batch(s, v.params);
             naive::FaHarrisNaive oracle(s, v.params);
+            std::vector<std::uint8_t> flags(ev.size());
+            detect(batch, std::span<const Event>(ev), flags);  // the AVX2 loop where the CPU has it
             for (std::size_t i = 0; i < ev.size(); ++i) {
                 const bool want = oracle.process(ev[i]);
                 ASSERT_EQ(fast.process(ev[i]), want) << v.name << " seed " << seed << " event " << i;
+                ASSERT_EQ(flags[i] != 0, want) << v.name << " (detect) seed " << seed << " event " << i;
                 ASSERT_TRUE(same_score(fast.last_score(), oracle.last_score()))
                     << v.name << " seed " << seed << " event " << i << ": " << fast.last_score() << " vs "
                     << oracle.last_score();

@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "evcorner/arcstar.hpp"
 #include "evcorner/arcstar_test.hpp"
@@ -82,6 +83,10 @@ public:
     }
 
 private:
+    friend struct FaHarrisLoops;  // fa_harris.cpp: the batch loops of detect()
+    // process_unchecked() with a chosen newest-pixel search (arc_test.hpp).
+    template <class Search>
+    bool process_with(const Event& e) noexcept;
     [[nodiscard]] std::size_t index(int x, int y) const noexcept {
         return (static_cast<std::size_t>(y) + static_cast<std::size_t>(pad_)) * stride_ + static_cast<std::size_t>(x) +
                static_cast<std::size_t>(pad_);
@@ -103,5 +108,12 @@ private:
     double score_ = kNoScore;
 };
 static_assert(ScoredDetector<FaHarris>);
+
+/// detect() for FA-Harris: the same flags, with the AVX2 newest-pixel search where the CPU
+/// has it (EVCORNER_ARCSTAR_PATH=portable forces the portable loop). Checks as the generic
+/// detect() does. (detect() with scores is the generic one of scored_detector.hpp.)
+std::size_t detect(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
+/// detect() without the checks.
+std::size_t detect_unchecked(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
 
 }  // namespace evcorner
