@@ -112,7 +112,9 @@ TEST_P(ArcStarVsOracle, SameCornersEventForEventInEveryVariant) {
     std::size_t streams = 0, events = 0;
     for (const Variant& v : kVariants) {
         std::size_t corners = 0, passed = 0;
-        for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        // One seed on an HD sensor: each stream allocates three HD states.
+        const std::uint64_t seeds = s.pixels() > 500000 ? 1 : 3;
+        for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
             const auto ev = test::arcstar_stream(s, 30000, seed * 7919 + static_cast<std::uint64_t>(s.width), v.step_us,
                                                  v.pause_us);
             ArcStar fast(s, v.params);
@@ -140,9 +142,9 @@ TEST_P(ArcStarVsOracle, SameCornersEventForEventInEveryVariant) {
         }
         EXPECT_GT(passed, 0u) << v.name;
         if (v.params.filter) {
-            EXPECT_LT(passed, 3 * 30000u) << v.name;
+            EXPECT_LT(passed, seeds * 30000u) << v.name;
         } else {
-            EXPECT_EQ(passed, 3 * 30000u) << v.name;
+            EXPECT_EQ(passed, seeds * 30000u) << v.name;
         }
     }
     std::printf("[ compared ] %zu streams, %zu events on %dx%d\n", streams, events, s.width, s.height);

@@ -50,7 +50,10 @@ TEST_P(FaHarrisVsOracle, SameCornersAndScoresEventForEvent) {
     std::size_t streams = 0, events = 0, scored_total = 0;
     for (const Variant& v : kVariants) {
         std::size_t corners = 0, scored = 0;
-        for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        // One seed on an HD sensor: each stream allocates three HD states (the page faults
+        // of a virtual machine make that the cost of the test).
+        const std::uint64_t seeds = s.pixels() > 500000 ? 1 : 3;
+        for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
             const auto ev = test::arcstar_stream(s, n, seed * 104729 + static_cast<std::uint64_t>(s.height), v.step_us,
                                                  v.pause_us);
             FaHarris fast(s, v.params), batch(s, v.params);
