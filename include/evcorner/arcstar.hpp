@@ -1,0 +1,140 @@
+#pragma once
+// Arc*: the asynchronous corner detector of
+//   I. Alzugaray, M. Chli, "Asynchronous Corner Detection and Tracking for Event Cameras
+//   in Real Time", IEEE RA-L 2018,
+// exact to its authors' implementation (docs/arcstar.md), on any sensor size.
+// Per event: a 50 ms filter (an event passes iff its pixel has been quiet with its polarity
+// for more than 50 ms, or fired with the other polarity since, or never fired); a passing
+// event writes the filtered SAE of its polarity; away from the border it is a corner iff
+// the Arc* arc test (arcstar_test.hpp) passes on the radius-3 and then the radius-4 circle.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "evcorner/arcstar_test.hpp"
+#include "evcorner/circle.hpp"
+#include "evcorner/detector.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/event_check.hpp"
+#include "evcorner/sae.hpp"
+#include "evcorner/sensor.hpp"
+#include "evcorner/zeroed_array.hpp"
+
+namespace evcorner {
+
+struct ArcStarParams {
+    bool filter = true;                ///< the published filter; false: every event passes
+    std::int64_t filter_us = 50000;    ///< the filter window in us, 0..kMaxFilterUs
+    bool minority_only = false;        ///< accept only arcs of Lmin..Lmax, not the majority arcs
+    bool zero_init = false;            ///< the authors' zero-initialised filter (never = time 0)
+};
+
+class ArcStar {
+public:
+    using Params = ArcStarParams;
+    static constexpr int kArc3Min = 3, kArc3Max = 6;
+    static constexpr int kArc4Min = 4, kArc4Max = 8;
+    static constexpr std::int64_t kMaxFilterUs = std::int64_t{1} << 40;  // about 12.7 days
+
+    /// Throws std::invalid_argument for filter_us or a sensor side out of range. `planes`
+    /// is accepted for the detector contract and ignored: the filter reads the other
+    /// polarity, so both are always kept.
+    explicit ArcStar(SensorSize size, const Params& params = {}, int planes = 2);
+
+    /// Bytes of state: per pixel the latest time of each polarity and the filtered SAE of
+    /// each polarity (32 bytes).
+    [[nodiscard]] static constexpr std::uint64_t state_bytes(SensorSize size, const Params& = {}, int = 2) noexcept {
+        return Sae::state_bytes(size, 2) + static_cast<std::uint64_t>(size.pixels()) * sizeof(ArcStarLatest);
+    }
+
+    /// What process() accepts: events on the sensor, polarity 0/1, time within the SAE's range.
+    [[nodiscard]] EventLimits limits() const noexcept { return {sae_.size(), Sae::kMinTime, Sae::kMaxTime}; }
+
+    /// Filters `e`, updates the state and answers whether `e` is a corner event. Throws
+    /// InvalidEvent (state unchanged) for an event limits() does not accept.
+    bool process(const Event& e) {
+        check_event(e, limits());
+        return process_unchecked(e);
+    }
+    /// process() without the check: `e` must be accepted by limits().
+    bool process_unchecked(const Event& e) noexcept { return View::make(*this).process<ScalarSearch>(e); }
+
+    /// detect_unchecked() over a span with a chosen newest-pixel search (arc_test.hpp).
+    template <class Search>
+    std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+        const View v = View::make(*this);
+        std::size_t corners = 0;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            const bool c = v.template process<Search>(events[i]);
+            is_corner[i] = static_cast<std::uint8_t>(c);
+            corners += c;
+        }
+        return corners;
+    }
+
+    [[nodiscard]] const Params& params() const noexcept { return params_; }
+    [[nodiscard]] SensorSize size() const noexcept { return sae_.size(); }
+    /// The filtered SAE (only events that passed the filter).
+    [[nodiscard]] const Sae& sae() const noexcept { return sae_; }
+    /// The time of the latest event (filtered or not) at (x, y) of polarity p, or Sae::kNever.
+    [[nodiscard]] std::int64_t latest(int p, int x, int y) const noexcept {
+        const std::int64_t v = latest_[static_cast<std::size_t>(y) * static_cast<std::size_t>(size().width) +
+                                        static_cast<std::size_t>(x)].t[p & 1];
+        return v == 0 ? Sae::kNever : v - Sae::kBias;
+    }
+    [[nodiscard]] std::size_t memory_bytes() const noexcept {
+        return sae_.memory_bytes() + latest_.size() * sizeof(ArcStarLatest);
+    }
+
+private:
+    // The per-event path on plain values (held in locals over a whole span).
+    struct View {
+        std::int64_t* plane[2];
+        ArcStarLatest* latest;
+        std::ptrdiff_t width;
+        int height;
+        std::int64_t window;
+        bool filter, minority_only, zero_init;
+
+        static View make(ArcStar& d) noexcept {
+            return {{d.sae_.plane(0), d.sae_.plane(1)}, d.latest_.data(), d.sae_.size().width, d.sae_.size().height,
+                    d.params_.filter_us, d.params_.filter, d.params_.minority_only, d.params_.zero_init};
+        }
+
+        template <class Search>
+        bool process(const Event& e) const noexcept {
+            const int p = e.p & 1;
+            const std::ptrdiff_t i = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
+            const std::int64_t st = Sae::stored(e.t);
+            ArcStarLatest& l = latest[i];
+            const bool pass = !filter | arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, zero_init);
+            l.t[p] = st;
+            if (!pass) return false;
+            std::int64_t* const centre = plane[p] + i;
+            *centre = st;
+            if (e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
+                e.y >= height - kCircleMargin)
+                return false;
+            const std::ptrdiff_t w = width;
+            return arcstar_circle_passes<kCircle3.size(), kArc3Min, kArc3Max, Search>(
+                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only) &&
+                   arcstar_circle_passes<kCircle4.size(), kArc4Min, kArc4Max, Search>(
+                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+        }
+    };
+
+    Params params_;
+    Sae sae_;
+    ZeroedArray<ArcStarLatest> latest_;
+};
+static_assert(Detector<ArcStar>);
+
+/// detect() for Arc*: the same flags, with the fastest newest-pixel search this CPU runs
+/// (AVX2 where it has it, else portable), chosen once per process. Checks as the generic
+/// detect() does (InvalidEvent before any event is processed).
+std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
+/// detect() without the checks.
+std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+
+}  // namespace evcorner

@@ -1,0 +1,247 @@
+#pragma once
+// The two per-event tests of Arc* (Alzugaray and Chli, "Asynchronous Corner Detection and
+// Tracking for Event Cameras in Real Time", RA-L 2018), shared by ArcStar (arcstar.hpp) and
+// FA-Harris (fa_harris.hpp), which uses Arc* as its candidate stage. docs/arcstar.md gives
+// the exact definitions; both work on stored SAE values (sae.hpp: t + Sae::kBias, 0 = never
+// fired), whose order is the order of the times.
+//
+// - The filter: an event passes iff its pixel never fired with its polarity, or the
+//   latest event there of its polarity is more than `window` us older, or the pixel fired
+//   with the other polarity since. The caller records the event as the pixel's latest in
+//   every case.
+// - The arc test on one circle: grow an arc from the first newest pixel, taking the
+//   newer of the two frontier pixels each time (ties: counter-clockwise), Lmin-1 times
+//   unconditionally, then on to the whole circle, where a frontier pixel at least as new
+//   as the arc's oldest (seg) extends the arc to everything visited so far. The circle
+//   passes iff the final size is within Lmin..Lmax or (unless minority_only) within
+//   N-Lmax..N-Lmin.
+
+#include <cstdint>
+
+#include "evcorner/arc_test.hpp"
+#include "evcorner/sae.hpp"
+
+namespace evcorner {
+
+/// The latest (unfiltered) event times of one pixel, one per polarity, stored form.
+/// Interleaved so that the filter's two reads and one write touch one 16-byte cell.
+struct ArcStarLatest {
+    std::int64_t t[2];
+};
+
+/// The Arc* filter on stored values: `st` the event's stored time, `own` and `other` the
+/// pixel's latest stored times of the event's polarity and of the other one (0 = never).
+/// `zero_init`: the authors' zero-initialised state, where a pixel that never fired reads
+/// as time 0 rather than as never (so an event at t <= window there is rejected).
+[[nodiscard]] inline bool arcstar_filter_passes(std::int64_t st, std::int64_t own, std::int64_t other,
+                                                std::int64_t window, bool zero_init) noexcept {
+    const std::int64_t zero = zero_init ? Sae::kBias : 0;  // what a never-fired cell reads as
+    own = detail::select(own == 0, zero, own);
+    other = detail::select(other == 0, zero, other);
+    // Non-short-circuit: one branch-free test.
+    return (own == 0) | (st - own > window) | (other > own);
+}
+
+namespace detail {
+/// c ? a : b as a conditional move: the compiler turns some such choices into branches,
+/// and on the arc growth's data they mispredict.
+template <class T>
+inline T cmov(bool c, T a, T b) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+    const unsigned flag = c;
+    __asm__("test %[f], %[f]\n\tcmovne %[a], %[b]" : [b] "+r"(b) : [a] "r"(a), [f] "r"(flag) : "cc");
+    return b;
+#else
+    return c ? a : b;
+#endif
+}
+}  // namespace detail
+
+/// Whether an Arc* arc of final `size` passes on a circle of N pixels.
+template <int N, int Lmin, int Lmax>
+[[nodiscard]] inline bool arcstar_size_passes(int size, bool minority_only) noexcept {
+    return (size <= Lmax) | (!minority_only & (size >= N - Lmax) & (size <= N - Lmin));
+}
+
+/// The final arc size of the Arc* growth on the circle t[0..N) given twice (t[k + N] ==
+/// t[k]) from its first newest pixel `k` (the first index of the largest value).
+/// Branch-free; each frontier's next value is loaded one step ahead, so that the chain
+/// from one step's choice to the next is a compare and a conditional move, not a load.
+template <int N, int Lmin, int Lmax>
+[[nodiscard]] inline int arcstar_arc_size(const std::int64_t* t, int k) noexcept {
+    static_assert(2 <= Lmin && Lmin <= Lmax && Lmax < N);
+    using detail::min;
+    // Frontiers as indices into the doubled circle: cw from k+1 up, ccw from k-1+N down;
+    // N-1 steps in all keep both within [0, 2N).
+    int cw = k + 1;
+    int ccw = k - 1 + N;
+    std::int64_t vc = t[cw], vd = t[ccw];           // the frontier values
+    std::int64_t nc = t[cw + 1], nd = t[ccw - 1];   // the values one step beyond them
+    std::int64_t min_cw = vc, min_ccw = vd;         // smallest visited per side, frontier included
+    std::int64_t seg = t[k];
+    int size = Lmin;
+    // Every choice a conditional move (detail::cmov): one instruction where the mask form
+    // of detail::select costs four, and never a branch on the data.
+#pragma GCC unroll 32
+    for (int it = 1; it < N; ++it) {
+        const bool go_cw = vc > vd;
+        const std::int64_t v = detail::cmov(go_cw, vc, vd);  // the value taken (the larger one)
+        const std::int64_t side_min = detail::cmov(go_cw, min_cw, min_ccw);
+        if (it < Lmin) {
+            seg = detail::cmov(seg < side_min, seg, side_min);
+        } else {
+            const bool grow = v >= seg;
+            size = detail::cmov(grow, it + 1, size);
+            const std::int64_t grown = detail::cmov(seg < side_min, seg, side_min);
+            seg = detail::cmov(grow, grown, seg);
+        }
+        // Advance the chosen side; its new frontier is the value loaded ahead.
+        cw += go_cw;
+        ccw -= !go_cw;
+        vc = detail::cmov(go_cw, nc, vc);
+        vd = detail::cmov(go_cw, vd, nd);
+        min_cw = detail::cmov(min_cw < vc, min_cw, vc);
+        min_ccw = detail::cmov(min_ccw < vd, min_ccw, vd);
+        if (it + 1 < N) {
+            nc = t[cw + 1];
+            nd = t[ccw - 1];
+        }
+    }
+    return size;
+}
+
+/// An exact shortcut for the commonest outcome on real data: whether the Arc* growth from
+/// `k` (as in arcstar_arc_size) surely ends with size N, told from bit masks without
+/// the growth. Proof (docs/arcstar.md): the growth consumes pixels in decreasing order of
+/// their side's running minimum ("key"; ties counter-clockwise first), so with m the
+/// circle's oldest value, held by at least two pixels besides k, the first of them is
+/// consumed at step g = i1 + j1 - 1 (i1, j1: their distances from k clockwise and
+/// counter-clockwise) and every pixel after it has key m. If g < Lmin, the forced growth
+/// takes seg down to m and every later pixel grows the arc; otherwise any later pixel (all
+/// lie on the far arc between those two) at least as new as `bound` >= seg grows it, seg
+/// becomes m and so does every pixel after. Either way the last step grows: size N.
+/// `bound`: the best oldest of the Lmin-windows through k, an upper bound of seg after the
+/// forced growth. False means "not known", not "not N".
+namespace detail {
+// Bit k set where t[k] (k < N) equals m, and where t[k] >= bound: the masks of
+// arcstar_surely_full, in circle order (not yet rotated). Portable form.
+template <int N>
+struct ArcMasks {
+    static void get(const std::int64_t* t, std::int64_t m, std::int64_t bound, std::uint32_t& eq,
+                    std::uint32_t& ge) noexcept {
+        eq = 0;
+        ge = 0;
+#pragma GCC unroll 32
+        for (int k = 0; k < N; ++k) {
+            eq |= static_cast<std::uint32_t>(t[k] == m) << k;
+            ge |= static_cast<std::uint32_t>(t[k] >= bound) << k;
+        }
+    }
+    static std::int64_t oldest(const std::int64_t* t) noexcept {
+        std::int64_t m = t[0];
+#pragma GCC unroll 32
+        for (int k = 1; k < N; ++k) m = min(m, t[k]);
+        return m;
+    }
+};
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+// The same four lanes at a time (for code compiled for AVX2 only).
+template <int N>
+struct ArcMasksAvx2 {
+    static_assert(N % 4 == 0);
+    [[gnu::target("avx2")]] static void get(const std::int64_t* t, std::int64_t m,
+                                                                        std::int64_t bound, std::uint32_t& eq,
+                                                                        std::uint32_t& ge) noexcept {
+        const __m256i vm = _mm256_set1_epi64x(m);
+        const __m256i vb = _mm256_set1_epi64x(bound);
+        eq = 0;
+        ge = 0;
+        for (int i = 0; i < N / 4; ++i) {
+            const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 4 * i));
+            eq |= static_cast<std::uint32_t>(_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(v, vm))))
+                  << (4 * i);
+            // t >= bound  <=>  !(bound > t)
+            ge |= static_cast<std::uint32_t>(~_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpgt_epi64(vb, v))) & 15)
+                  << (4 * i);
+        }
+    }
+    [[gnu::target("avx2")]] static std::int64_t oldest(const std::int64_t* t) noexcept {
+        __m256i mn = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t));
+        for (int i = 1; i < N / 4; ++i) {
+            const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + 4 * i));
+            mn = _mm256_blendv_epi8(mn, v, _mm256_cmpgt_epi64(mn, v));
+        }
+        mn = _mm256_blendv_epi8(mn, _mm256_permute4x64_epi64(mn, 0x4E),
+                                _mm256_cmpgt_epi64(mn, _mm256_permute4x64_epi64(mn, 0x4E)));
+        mn = _mm256_blendv_epi8(mn, _mm256_shuffle_epi32(mn, 0x4E), _mm256_cmpgt_epi64(mn, _mm256_shuffle_epi32(mn, 0x4E)));
+        return _mm256_extract_epi64(mn, 0);
+    }
+};
+#endif
+template <class Search, int N>
+struct ArcMasksFor {
+    using type = ArcMasks<N>;
+};
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+template <int N>
+struct ArcMasksFor<Avx2Search, N> {
+    using type = ArcMasksAvx2<N>;
+};
+#endif
+}  // namespace detail
+
+/// An exact shortcut for the commonest outcome on real data: whether the Arc* growth from
+/// `k` (as in arcstar_arc_size) surely ends with size N, told from bit masks without
+/// the growth. Proof (docs/arcstar.md): the growth consumes pixels in decreasing order of
+/// their side's running minimum ("key"; ties counter-clockwise first), so with m the
+/// circle's oldest value, held by at least two pixels besides k, the first of them is
+/// consumed at step g = i1 + j1 - 1 (i1, j1: their distances from k clockwise and
+/// counter-clockwise) and every pixel after it has key m. If g < Lmin, the forced growth
+/// takes seg down to m and every later pixel grows the arc; otherwise any later pixel (all
+/// lie on the far arc between those two) at least as new as `bound` >= seg grows it, seg
+/// becomes m and so does every pixel after. Either way the last step grows: size N.
+/// `bound`: the best oldest of the Lmin-windows through k, an upper bound of seg after the
+/// forced growth. False means "not known", not "not N". `t` is the circle twice.
+template <int N, int Lmin, class Search = ScalarSearch>
+[[nodiscard]] inline bool arcstar_surely_full(const std::int64_t* t, int k) noexcept {
+    using detail::max;
+    using detail::min;
+    using Masks = typename detail::ArcMasksFor<Search, N>::type;
+    const std::int64_t m = Masks::oldest(t);
+    const int c = k + N * static_cast<int>(k < Lmin);  // a copy of k with +-(Lmin-1) inside [0, 2N)
+    std::int64_t bound = INT64_MIN;
+#pragma GCC unroll 8
+    for (int s = 0; s < Lmin; ++s) {
+        std::int64_t w = t[c - s];
+        for (int q = 1; q < Lmin; ++q) w = min(w, t[c - s + q]);
+        bound = max(bound, w);
+    }
+    std::uint32_t eq, ge;
+    Masks::get(t, m, bound, eq, ge);
+    // Rotate so that bit j is the pixel j steps clockwise from k; drop k itself.
+    constexpr std::uint32_t kAll = (std::uint32_t{1} << N) - 1;
+    const auto rot = [k](std::uint32_t x) {
+        return ((x >> k) | (x << ((N - k) & 31))) & kAll;
+    };
+    const std::uint32_t oldest = rot(eq) & ~std::uint32_t{1};
+    if (__builtin_popcount(oldest) < 2) return false;
+    const int i1 = __builtin_ctz(oldest);
+    const int hi = 31 - __builtin_clz(oldest);  // j1 = N - hi
+    const std::uint32_t far = ((std::uint32_t{2} << hi) - 1) & ~((std::uint32_t{1} << i1) - 1);
+    return (i1 + (N - hi) <= Lmin) | ((rot(ge) & far) != 0);
+}
+
+/// Gathers the circle around `centre` (pixel k at centre[offset(k)]) and runs the Arc*
+/// arc test on it; `Search` finds the first newest pixel (arc_test.hpp; all of them
+/// return the first index of the largest value).
+template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
+[[nodiscard]] inline bool arcstar_circle_passes(const std::int64_t* centre, Offset offset, bool minority_only) noexcept {
+    std::int64_t t[2 * N];
+#pragma GCC unroll 32
+    for (int k = 0; k < N; ++k) t[k] = centre[offset(k)];
+    const int newest = Search::template newest<N>(t);
+    if (arcstar_surely_full<N, Lmin, Search>(t, newest)) return arcstar_size_passes<N, Lmin, Lmax>(N, minority_only);
+    return arcstar_size_passes<N, Lmin, Lmax>(arcstar_arc_size<N, Lmin, Lmax>(t, newest), minority_only);
+}
+
+}  // namespace evcorner

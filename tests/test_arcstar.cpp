@@ -1,0 +1,307 @@
+// Arc* on drawn timestamp grids (an outside corner, an inside corner, a straight edge, bar
+// ends, ties), the 50 ms filter's behaviour (first event of a pixel, a burst under 50 ms,
+// a polarity flip, the window's edge, the zero-initialised variant), the parameters and
+// bad events. Every grid outcome is also asserted for the oracle.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "evcorner/arcstar.hpp"
+#include "evcorner/naive/arcstar_naive.hpp"
+
+namespace evcorner {
+namespace {
+
+struct Cell {
+    std::int64_t t;
+    int x, y;
+};
+
+// A drawn 9x9 window of one polarity's SAE around 'E' ('.' = never fired), placed with its
+// top-left pixel at (x0, y0); cells sorted by time.
+std::vector<Cell> parse_grid(const std::vector<std::string>& rows, int x0, int y0, int& ex, int& ey) {
+    std::vector<Cell> cells;
+    for (int r = 0; r < static_cast<int>(rows.size()); ++r) {
+        std::istringstream in(rows[r]);
+        std::string tok;
+        for (int c = 0; in >> tok; ++c) {
+            if (tok == ".") continue;
+            if (tok == "E") {
+                ex = x0 + c;
+                ey = y0 + r;
+                continue;
+            }
+            cells.push_back({std::stoll(tok), x0 + c, y0 + r});
+        }
+    }
+    std::stable_sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.t < b.t; });
+    return cells;
+}
+
+// Feeds the grid (first events of their pixels: all pass the filter) then 'E' at t = 1000;
+// returns the fast detector's answer after checking that the oracle gives the same.
+bool grid_is_corner(const std::vector<std::string>& rows, const ArcStarParams& params = {}) {
+    const SensorSize size{20, 20};
+    ArcStar fast(size, params);
+    naive::ArcStarNaive oracle(size, params);
+    int ex = -1, ey = -1;
+    for (const Cell& c : parse_grid(rows, 5, 5, ex, ey)) {
+        const Event e{c.t, static_cast<std::uint16_t>(c.x), static_cast<std::uint16_t>(c.y), 1};
+        EXPECT_EQ(fast.process(e), oracle.process(e));
+    }
+    EXPECT_GE(ex, 0) << "grid has no 'E'";
+    const Event e{1000, static_cast<std::uint16_t>(ex), static_cast<std::uint16_t>(ey), 1};
+    const bool c = fast.process(e);
+    EXPECT_EQ(c, oracle.process(e));
+    return c;
+}
+
+// Newest pixels (9) in the quadrant below and right of the event, older ones (2) elsewhere:
+// radius 3 sees an arc of 3 newest pixels, radius 4 one of 4. Minority arcs: a corner.
+const std::vector<std::string> kOutsideCorner = {
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 E 2 2 2 2",
+    "2 2 2 2 2 9 9 9 9",
+    "2 2 2 2 2 9 9 9 9",
+    "2 2 2 2 2 9 9 9 9",
+    "2 2 2 2 2 9 9 9 9",
+};
+
+// The complement: the older quadrant is the only one below-right: radius 3 has a newest
+// arc of 13 = N - Lmin pixels, radius 4 one of 16 = N - Lmin: majority arcs.
+const std::vector<std::string> kInsideCorner = {
+    "9 9 9 9 9 9 9 9 9",
+    "9 9 9 9 9 9 9 9 9",
+    "9 9 9 9 9 9 9 9 9",
+    "9 9 9 9 9 9 9 9 9",
+    "9 9 9 9 E 9 9 9 9",
+    "9 9 9 9 9 2 2 2 2",
+    "9 9 9 9 9 2 2 2 2",
+    "9 9 9 9 9 2 2 2 2",
+    "9 9 9 9 9 2 2 2 2",
+};
+
+// A horizontal edge: the rows below the event are newer. Radius 3: 7 newest pixels,
+// neither a minority (<= 6) nor a majority (>= 10) arc.
+const std::vector<std::string> kStraightEdge = {
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 E 2 2 2 2",
+    "9 9 9 9 9 9 9 9 9",
+    "9 9 9 9 9 9 9 9 9",
+    "9 9 9 9 9 9 9 9 9",
+    "9 9 9 9 9 9 9 9 9",
+};
+
+// The end of a 5-pixel-wide bar coming from below: 5 newest pixels on each circle.
+const std::vector<std::string> kWideBarEnd = {
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 E 2 2 2 2",
+    "2 2 9 9 9 9 9 2 2",
+    "2 2 9 9 9 9 9 2 2",
+    "2 2 9 9 9 9 9 2 2",
+    "2 2 9 9 9 9 9 2 2",
+};
+
+// A 3-pixel-wide bar end: 3 newest pixels on radius 3 (an arc), but only 3 on radius 4,
+// where the forced growth to Lmin = 4 takes an old pixel: seg drops to the old value, every
+// other pixel ties with it and grows the arc to the whole circle (20): not a corner.
+const std::vector<std::string> kNarrowBarEnd = {
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 2 2 2 2 2",
+    "2 2 2 2 E 2 2 2 2",
+    "2 2 2 9 9 9 2 2 2",
+    "2 2 2 9 9 9 2 2 2",
+    "2 2 2 9 9 9 2 2 2",
+    "2 2 2 9 9 9 2 2 2",
+};
+
+std::vector<std::string> replace(std::vector<std::string> rows, char from, char to) {
+    for (auto& r : rows) std::replace(r.begin(), r.end(), from, to);
+    return rows;
+}
+
+TEST(ArcStarGrid, OutsideCornerIsACorner) {
+    EXPECT_TRUE(grid_is_corner(kOutsideCorner));
+    EXPECT_TRUE(grid_is_corner(kOutsideCorner, {.minority_only = true}));
+}
+
+TEST(ArcStarGrid, InsideCornerIsACornerOnlyThroughTheMajorityArcs) {
+    EXPECT_TRUE(grid_is_corner(kInsideCorner));
+    EXPECT_FALSE(grid_is_corner(kInsideCorner, {.minority_only = true}));
+}
+
+TEST(ArcStarGrid, StraightEdgeIsNotACorner) {
+    EXPECT_FALSE(grid_is_corner(kStraightEdge));
+    EXPECT_FALSE(grid_is_corner(kStraightEdge, {.minority_only = true}));
+}
+
+TEST(ArcStarGrid, BarEnds) {
+    EXPECT_TRUE(grid_is_corner(kWideBarEnd));
+    EXPECT_FALSE(grid_is_corner(kNarrowBarEnd));
+}
+
+TEST(ArcStarGrid, Ties) {
+    // The newest quadrant tied with the rest: one value everywhere, every pixel grows the
+    // arc, size N on both circles: not a corner.
+    EXPECT_FALSE(grid_is_corner(replace(kOutsideCorner, '9', '2')));
+    // Newer by one tick is enough.
+    EXPECT_TRUE(grid_is_corner(replace(kOutsideCorner, '9', '3')));
+    // Never-fired pixels are the oldest of all: the corner over an unlit background.
+    EXPECT_TRUE(grid_is_corner(replace(kOutsideCorner, '2', '.')));
+}
+
+// ---- the filter
+
+const SensorSize kSensor{30, 30};
+Event ev(std::int64_t t, int x, int y, int p) {
+    return {t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), static_cast<std::uint8_t>(p)};
+}
+
+TEST(ArcStarFilter, FirstEventOfAPixelPasses) {
+    ArcStar det(kSensor);
+    det.process(ev(5, 10, 10, 1));
+    EXPECT_EQ(det.sae().at(1, 10, 10), 5);
+    EXPECT_EQ(det.latest(1, 10, 10), 5);
+    // The other polarity's first event at the same pixel, 1 us later, passes too.
+    det.process(ev(6, 10, 10, 0));
+    EXPECT_EQ(det.sae().at(0, 10, 10), 6);
+}
+
+TEST(ArcStarFilter, BurstUnder50msPassesOnlyItsFirstEvent) {
+    ArcStar det(kSensor);
+    for (std::int64_t t = 100000; t <= 300000; t += 10000) {
+        det.process(ev(t, 10, 10, 1));
+        EXPECT_EQ(det.latest(1, 10, 10), t);            // the latest time follows every event
+        EXPECT_EQ(det.sae().at(1, 10, 10), 100000);     // the filtered SAE keeps the first
+    }
+    // Exactly 50 ms after the latest event is still too soon (strict).
+    det.process(ev(350000, 10, 10, 1));
+    EXPECT_EQ(det.sae().at(1, 10, 10), 100000);
+    // More than 50 ms after the latest one passes.
+    det.process(ev(400001, 10, 10, 1));
+    EXPECT_EQ(det.sae().at(1, 10, 10), 400001);
+}
+
+TEST(ArcStarFilter, PolarityFlipPasses) {
+    ArcStar det(kSensor);
+    det.process(ev(1000, 10, 10, 1));   // ON, passes (first)
+    det.process(ev(11000, 10, 10, 0));  // OFF, passes (first of its polarity)
+    det.process(ev(21000, 10, 10, 1));  // ON 20 ms after ON, but OFF fired since: passes
+    EXPECT_EQ(det.sae().at(1, 10, 10), 21000);
+    det.process(ev(31000, 10, 10, 1));  // ON again, no OFF since: rejected
+    EXPECT_EQ(det.sae().at(1, 10, 10), 21000);
+    EXPECT_EQ(det.latest(1, 10, 10), 31000);
+}
+
+TEST(ArcStarFilter, PixelsAreFilteredApart) {
+    ArcStar det(kSensor);
+    det.process(ev(1000, 10, 10, 1));
+    det.process(ev(2000, 11, 10, 1));  // a neighbour's first event passes
+    EXPECT_EQ(det.sae().at(1, 11, 10), 2000);
+}
+
+TEST(ArcStarFilter, RejectedEventIsNotACornerAndLeavesTheSaeAlone) {
+    // An outside corner drawn on the filtered SAE, then the centre pixel fires twice: its
+    // first event is a corner, the second (1 us later, rejected) is not.
+    ArcStar det({20, 20});
+    int ex = -1, ey = -1;
+    for (const Cell& c : parse_grid(kOutsideCorner, 5, 5, ex, ey))
+        det.process(ev(c.t, c.x, c.y, 1));
+    EXPECT_TRUE(det.process(ev(1000, ex, ey, 1)));
+    EXPECT_FALSE(det.process(ev(1001, ex, ey, 1)));
+    EXPECT_EQ(det.sae().at(1, ex, ey), 1000);
+    // Without the filter the second is a corner too.
+    ArcStar unfiltered({20, 20}, {.filter = false});
+    for (const Cell& c : parse_grid(kOutsideCorner, 5, 5, ex, ey))
+        unfiltered.process(ev(c.t, c.x, c.y, 1));
+    EXPECT_TRUE(unfiltered.process(ev(1000, ex, ey, 1)));
+    EXPECT_TRUE(unfiltered.process(ev(1001, ex, ey, 1)));
+}
+
+TEST(ArcStarFilter, ZeroInitialisedVariantRejectsFirstEventsInTheFirstWindow) {
+    ArcStar never(kSensor), zero(kSensor, {.zero_init = true});
+    for (ArcStar* d : {&never, &zero}) {
+        d->process(ev(30000, 10, 10, 1));   // before 50 ms
+        d->process(ev(50001, 12, 10, 1));   // just after
+    }
+    EXPECT_EQ(never.sae().at(1, 10, 10), 30000);
+    EXPECT_EQ(zero.sae().at(1, 10, 10), Sae::kNever);
+    EXPECT_EQ(zero.latest(1, 10, 10), 30000);
+    EXPECT_EQ(never.sae().at(1, 12, 10), 50001);
+    EXPECT_EQ(zero.sae().at(1, 12, 10), 50001);
+}
+
+TEST(ArcStarFilter, WindowIsAParameter) {
+    ArcStar det(kSensor, {.filter_us = 100});
+    det.process(ev(1000, 10, 10, 1));
+    det.process(ev(1100, 10, 10, 1));  // 100 us: rejected
+    EXPECT_EQ(det.sae().at(1, 10, 10), 1000);
+    det.process(ev(1201, 10, 10, 1));  // 101 us after the latest: passes
+    EXPECT_EQ(det.sae().at(1, 10, 10), 1201);
+}
+
+TEST(ArcStarFilter, BorderEventsAreFilteredAndWrittenButNeverCorners) {
+    ArcStar det(kSensor, {.filter = false});
+    for (int x : {0, 3, 26, 29})
+        for (int y : {0, 3, 15, 26, 29}) {
+            EXPECT_FALSE(det.process(ev(100, x, y, 0)));
+            EXPECT_EQ(det.sae().at(0, x, y), 100);
+        }
+}
+
+// ---- parameters, bad events, memory
+
+TEST(ArcStarParams, OutOfRangeIsRejectedWithItsName) {
+    try {
+        ArcStar det(kSensor, {.filter_us = -1});
+        FAIL() << "no exception";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("filter_us"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(ArcStar(kSensor, {.filter_us = ArcStar::kMaxFilterUs + 1}), std::invalid_argument);
+    EXPECT_NO_THROW(ArcStar(kSensor, {.filter_us = ArcStar::kMaxFilterUs}));
+    EXPECT_THROW(ArcStar(SensorSize{0, 10}), std::invalid_argument);
+    EXPECT_THROW(ArcStar(SensorSize{10, 70000}), std::invalid_argument);
+}
+
+TEST(ArcStarEvents, BadEventsThrowAndChangeNothing) {
+    ArcStar det(kSensor);
+    det.process(ev(1000, 10, 10, 1));
+    for (const Event& bad : {ev(2000, 30, 10, 1), ev(2000, 10, 30, 1), ev(2000, 10, 10, 2),
+                             ev(Sae::kMaxTime + 1, 10, 10, 1), ev(Sae::kMinTime - 1, 10, 10, 1)}) {
+        EXPECT_THROW(det.process(bad), InvalidEvent);
+        std::vector<std::uint8_t> flags(2);
+        const std::vector<Event> batch{ev(900000, 10, 10, 1), bad};
+        EXPECT_THROW(detect(det, std::span<const Event>(batch), flags), InvalidEvent);
+    }
+    // Nothing was recorded: not even the good first event of the rejected batch.
+    EXPECT_EQ(det.latest(1, 10, 10), 1000);
+    EXPECT_EQ(det.sae().at(1, 10, 10), 1000);
+}
+
+TEST(ArcStarMemory, StateBytesMatchTheAllocation) {
+    for (SensorSize s : {SensorSize{240, 180}, SensorSize{17, 13}, SensorSize{1280, 720}}) {
+        ArcStar det(s);
+        EXPECT_EQ(det.memory_bytes(), ArcStar::state_bytes(s));
+        EXPECT_EQ(ArcStar::state_bytes(s), 32u * static_cast<std::uint64_t>(s.pixels()));
+    }
+}
+
+}  // namespace
+}  // namespace evcorner
