@@ -40,6 +40,13 @@ std::string format_param_value(const ParamValue& value) {
     return format_real(std::get<double>(value));
 }
 
+std::string param_key(std::string_view identifier) {
+    std::string key(identifier);
+    for (char& c : key)
+        if (c == '_') c = '-';
+    return key;
+}
+
 namespace detail {
 
 void param_error(std::string_view prefix, std::string_view key, const std::string& what) {

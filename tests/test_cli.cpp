@@ -219,8 +219,9 @@ TEST_F(Cli, DetectorParametersComeFromTheRegistry) {
     ASSERT_EQ(run("detect '" + sample_.string() + "' -d harris -q -o default.txt").status, 0);
     Result r = run("detect '" + sample_.string() + "' -d harris -q -o option.txt --harris-window 7");
     ASSERT_EQ(r.status, 0) << r.err;
-    r = run("detect '" + sample_.string() + "' -d harris -q -o param.txt -p harris-window=7");
+    r = run("detect '" + sample_.string() + "' -d harris -q -o param.txt -p harris-window=7 --summary-json s.json");
     ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(slurp(dir_ / "s.json").find("\"harris-window\": 7"), std::string::npos) << slurp(dir_ / "s.json");
     EXPECT_EQ(slurp(dir_ / "option.txt"), slurp(dir_ / "param.txt"));
     EXPECT_NE(slurp(dir_ / "option.txt"), slurp(dir_ / "default.txt"));
 

@@ -188,6 +188,9 @@ TEST(Registry, TypesAreEnforced) {
             << bad;
     EXPECT_THROW((void)parse_param_value("harris-k", "nan"), std::invalid_argument);
     EXPECT_THROW((void)parse_param_value("harris-k", "inf"), std::invalid_argument);
+    // A binding's keyword argument names the key as an identifier.
+    EXPECT_EQ(param_key("harris_window"), "harris-window");
+    EXPECT_NE(detector_info("harris").param(param_key("harris_nl")), nullptr);
     ParamValues v;
     parse_param_assignment("harris-window=13", v);
     EXPECT_EQ(std::get<std::int64_t>(*v.find("harris-window")), 13);

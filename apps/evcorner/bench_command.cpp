@@ -551,6 +551,7 @@ void add_bench_command(CLI::App& app) {
     cmd->footer(
         "Examples:\n"
         "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt\n"
+        "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt --min-events 1 --no-latency   # cold: one pass per file\n"
         "  evcorner bench recording.raw -d efast --repeat 9 --min-events 20000000 --json bench.json\n"
         "  evcorner bench hd.raw -d efast --threads 1,2          # multi-core speed-up");
     cmd->callback([o] { run_bench(*o); });

@@ -43,7 +43,9 @@ struct DetectOptions {
 void print_summary(const DetectOptions& o, const pipeline::DetectSummary& t) {
     const double events = static_cast<double>(t.events);
     fmt::print(stderr, "evcorner detect: {}\n", o.files.input == "-" ? "<stdin>" : o.files.input);
-    fmt::print(stderr, "  detector     {} on a {}x{} sensor\n", t.detector, t.sensor.width, t.sensor.height);
+    std::string params;
+    for (const auto& [key, value] : o.run.detector.params) params += fmt::format(" {}={}", key, format_param_value(value));
+    fmt::print(stderr, "  detector     {}{} on a {}x{} sensor\n", t.detector, params, t.sensor.width, t.sensor.height);
     fmt::print(stderr, "  events       {}\n", t.events);
     if (t.skipped > 0) fmt::print(stderr, "  skipped      {} (outside the sensor)\n", t.skipped);
     fmt::print(stderr, "  corners      {}\n", t.corners);
@@ -67,6 +69,11 @@ void write_summary_json(const DetectOptions& o, const pipeline::DetectSummary& t
     nlohmann::json j;
     j["input"] = o.files.input;
     j["detector"] = t.detector;
+    // The parameters given (the others are the detector's defaults).
+    nlohmann::json params = nlohmann::json::object();
+    for (const auto& [key, value] : o.run.detector.params)
+        std::visit([&](const auto& v) { params[key] = v; }, value);
+    j["params"] = params;
     j["width"] = t.sensor.width;
     j["height"] = t.sensor.height;
     j["events"] = t.events;

@@ -58,6 +58,10 @@ private:
     Map values_;
 };
 
+/// The key of a parameter named as an identifier, as a binding's keyword argument names
+/// it: "harris_window" -> "harris-window" (underscores become hyphens).
+std::string param_key(std::string_view identifier);
+
 /// A detector by name with the parameter values given (the others keep their defaults).
 struct DetectorConfig {
     std::string name = "efast";
