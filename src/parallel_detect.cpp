@@ -87,17 +87,19 @@ void WorkerPool::run(const std::function<void(int)>& job) {
     }
 }
 
-std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::span<const Event> sample) {
+std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::span<const Event> sample,
+                                   bool split_polarity) {
     const int h = size.height;
     const int min_rows = std::max(1, 2 * radius);
     bands = std::clamp(bands, 1, std::max(1, h / min_rows));
     std::vector<DetectPart> parts;
-    for (int p = 0; p < 2; ++p) {
-        // Rows' shares of this polarity's sample events.
+    // p = 0, 1 (one polarity each), or p = -1 alone (both).
+    for (int p = split_polarity ? 0 : -1; p < (split_polarity ? 2 : 0); ++p) {
+        // Rows' shares of this polarity's (or all) sample events.
         std::vector<std::uint64_t> count(static_cast<std::size_t>(h), 0);
         std::uint64_t total = 0;
         for (const Event& e : sample)
-            if ((e.p & 1) == p && e.y < h) {
+            if ((p < 0 || (e.p & 1) == p) && e.y < h) {
                 ++count[e.y];
                 ++total;
             }

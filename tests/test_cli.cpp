@@ -10,6 +10,7 @@
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/text_reader.hpp"
 #include "cli_test_util.hpp"
+#include "evcorner/registry.hpp"
 
 namespace evcorner {
 namespace {
@@ -211,6 +212,61 @@ TEST_F(Cli, ParametersOutOfRangeAreRejected) {
     r = run("detect '" + sample_.string() + "' -d harris-global --harris-n 0");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("--harris-n"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, DetectorParametersComeFromTheRegistry) {
+    // --KEY and -p KEY=VALUE set the same parameter, and it changes the result.
+    ASSERT_EQ(run("detect '" + sample_.string() + "' -d harris -q -o default.txt").status, 0);
+    Result r = run("detect '" + sample_.string() + "' -d harris -q -o option.txt --harris-window 7");
+    ASSERT_EQ(r.status, 0) << r.err;
+    r = run("detect '" + sample_.string() + "' -d harris -q -o param.txt -p harris-window=7 --summary-json s.json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(slurp(dir_ / "s.json").find("\"harris-window\": 7"), std::string::npos) << slurp(dir_ / "s.json");
+    EXPECT_EQ(slurp(dir_ / "option.txt"), slurp(dir_ / "param.txt"));
+    EXPECT_NE(slurp(dir_ / "option.txt"), slurp(dir_ / "default.txt"));
+
+    r = run("detect '" + sample_.string() + "' -d efast --harris-window 7 -q");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("detector 'efast' takes no parameter --harris-window"), std::string::npos) << r.err;
+    r = run("detect '" + sample_.string() + "' -d harris -p harris-n=5 -q");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("harris-n"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("it takes: --harris-window"), std::string::npos) << r.err;
+    r = run("detect '" + sample_.string() + "' -d harris -p no-such-key=5 -q");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("unknown parameter no-such-key"), std::string::npos) << r.err;
+    r = run("detect '" + sample_.string() + "' -d harris -p harris-window=eleven -q");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("harris-window takes an integer"), std::string::npos) << r.err;
+    r = run("detect '" + sample_.string() + "' -d harris --harris-window 7 -p harris-window=9 -q");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("given twice"), std::string::npos) << r.err;
+
+    // --help lists every detector and every parameter key of the registry.
+    r = run("detect --help");
+    ASSERT_EQ(r.status, 0);
+    for (const DetectorInfo& d : detector_infos()) {
+        EXPECT_NE(r.out.find(std::string(d.name)), std::string::npos) << d.name;
+        for (const ParamInfo& p : d.params) EXPECT_NE(r.out.find("--" + std::string(p.key)), std::string::npos) << p.key;
+    }
+    EXPECT_NE(r.out.find("-p,--param"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, ThreadsForEveryLocalDetectorGiveOneThreadsOutput) {
+    for (const DetectorInfo& d : detector_infos()) {
+        const std::string name(d.name);
+        const Result one = run("detect '" + sample_.string() + "' -d " + name + " -q -o one.txt --mask one.mask");
+        ASSERT_EQ(one.status, 0) << one.err;
+        const Result two = run("detect '" + sample_.string() + "' -d " + name + " -q --threads 3 -o two.txt --mask two.mask");
+        if (!d.local()) {
+            EXPECT_EQ(two.status, 2) << name;
+            EXPECT_NE(two.err.find(std::string(d.not_local)), std::string::npos) << two.err;
+            continue;
+        }
+        ASSERT_EQ(two.status, 0) << name << ": " << two.err;
+        EXPECT_EQ(slurp(dir_ / "two.txt"), slurp(dir_ / "one.txt")) << name;
+        EXPECT_EQ(slurp(dir_ / "two.mask"), slurp(dir_ / "one.mask")) << name;
+    }
 }
 
 TEST_F(Cli, CornersInOtherFormatsReadBackToTheSameEvents) {

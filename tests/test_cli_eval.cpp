@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli_test_util.hpp"
+#include "evcorner/registry.hpp"
 #include "evcorner/io/text_reader.hpp"
 
 namespace evcorner {
@@ -91,6 +92,33 @@ TEST_F(CliEval, EvalWritesBothTablesAndTheReport) {
     bool some_png = false;
     for (const auto& f : fs::directory_iterator(dir_ / "rep/figures")) some_png |= png_size(f.path()).first > 0;
     EXPECT_TRUE(some_png);
+}
+
+// Without -d, eval runs every registered detector: a Table 1 row and a Table 2 row each,
+// side by side in the report; each with the corners `evcorner detect -d NAME` finds.
+TEST_F(CliEval, EvalRunsEveryRegisteredDetectorByDefault) {
+    std::string err;
+    ASSERT_EQ(run_status("eval '" + sample_.string() + "' --repeat 1 -q --no-figures --report rep", &err), 0) << err;
+    const std::string t1 = slurp(dir_ / "rep/table1.csv");
+    const std::string t2 = slurp(dir_ / "rep/table2.csv");
+    const std::string md = slurp(dir_ / "rep/report.md");
+    for (const DetectorInfo& d : detector_infos()) {
+        const std::string name(d.name);
+        ASSERT_EQ(run_status("detect '" + sample_.string() + "' -d " + name + " -q -o c-" + name + ".txt", &err), 0) << err;
+        const std::size_t corners = test::count_lines(slurp(dir_ / ("c-" + name + ".txt")));
+        EXPECT_NE(t1.find("," + name + ",30000," + std::to_string(corners) + ","), std::string::npos) << name << "\n" << t1;
+        EXPECT_NE(t2.find("\n" + name + ",30000,"), std::string::npos) << name << "\n" << t2;
+        EXPECT_NE(md.find(" " + name + " Red. | " + name + " FT |"), std::string::npos) << name;
+    }
+    // -d all is the same list; a parameter reaches the detectors that take it, and one
+    // that none of them takes is refused.
+    ASSERT_EQ(run_status("eval '" + sample_.string() + "' -d all --harris-window 7 --repeat 1 -q --no-figures --report rep7", &err), 0)
+        << err;
+    ASSERT_EQ(run_status("detect '" + sample_.string() + "' -d harris --harris-window 7 -q -o h7.txt", &err), 0) << err;
+    EXPECT_NE(slurp(dir_ / "rep7/table1.csv").find(",harris,30000," + std::to_string(test::count_lines(slurp(dir_ / "h7.txt"))) + ","),
+              std::string::npos);
+    EXPECT_EQ(run_status("eval '" + sample_.string() + "' -d efast --harris-window 7 --repeat 1 -q", &err), 2);
+    EXPECT_NE(err.find("--harris-window"), std::string::npos) << err;
 }
 
 TEST_F(CliEval, RenderEveryKindAsPng) {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cli_test_util.hpp"
-#include "evcorner/any_detector.hpp"
+#include "evcorner/registry.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/io/open.hpp"

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "cli_test_util.hpp"
-#include "evcorner/any_detector.hpp"
+#include "evcorner/registry.hpp"
 #include "evcorner/efast.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/harris.hpp"

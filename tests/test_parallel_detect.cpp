@@ -1,9 +1,13 @@
 // Parallel detection: identical flags, in input order, to one detector on one thread,
 // for 1..4 threads and 1..3 parts per thread, on random HD streams, small sensors and
-// the bundled sample; batches queued ahead (prepare/run) as evcorner detect does.
+// the bundled sample; batches queued ahead (prepare/run) as evcorner detect does; for
+// every local detector of the registry, split as its entry says, and for a detector
+// whose decision reads the other polarity (parts of both polarities).
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -11,6 +15,7 @@
 #include "evcorner/harris.hpp"
 #include "evcorner/io/text_reader.hpp"
 #include "evcorner/parallel_detect.hpp"
+#include "evcorner/registry.hpp"
 #include "test_util.hpp"
 
 namespace evcorner {
@@ -50,7 +55,7 @@ std::vector<Event> random_stream(SensorSize s, std::size_t n, std::uint32_t seed
 }
 
 template <class D, class Make>
-void expect_same_as_one_thread(const std::vector<Event>& events, SensorSize s, int radius, Make make,
+void expect_same_as_one_thread(const std::vector<Event>& events, SensorSize s, Locality radius, Make make,
                                std::size_t batch, bool need_corners = true) {
     D one = make(s, 2);
     std::vector<std::uint8_t> expected(events.size());
@@ -199,6 +204,99 @@ TEST(ParallelDetect, PartsCoverTheSensorOnceWithHalos) {
                 }
         }
     }
+}
+
+// A detector whose decision reads both polarities within radius 2: an event is a corner
+// iff, in the 5x5 window around it (clipped to the sensor), at least 2 other pixels of its
+// polarity and 3 of the other polarity fired within the last 60 us. State: the latest
+// time per pixel and polarity (both planes always: it cannot work on one polarity).
+class CrossPolarity {
+public:
+    static constexpr int kRadius = 2;
+    explicit CrossPolarity(SensorSize s, int /*planes*/ = 2)
+        : size_(s), t_(2 * static_cast<std::size_t>(s.pixels()), std::numeric_limits<std::int64_t>::min() / 2) {}
+    [[nodiscard]] EventLimits limits() const noexcept { return {size_}; }
+    bool process(const Event& e) {
+        check_event(e, limits());
+        return process_unchecked(e);
+    }
+    bool process_unchecked(const Event& e) noexcept {
+        const int p = e.p & 1;
+        t_[at(p, e.x, e.y)] = e.t;
+        int own = -1, other = 0;  // own: not counting the event's pixel
+        for (int y = std::max(0, e.y - kRadius); y <= std::min(size_.height - 1, e.y + kRadius); ++y)
+            for (int x = std::max(0, e.x - kRadius); x <= std::min(size_.width - 1, e.x + kRadius); ++x) {
+                own += t_[at(p, x, y)] >= e.t - 60;
+                other += t_[at(1 - p, x, y)] >= e.t - 60;
+            }
+        return own >= 2 && other >= 3;
+    }
+
+private:
+    [[nodiscard]] std::size_t at(int p, int x, int y) const noexcept {
+        return (static_cast<std::size_t>(p) * static_cast<std::size_t>(size_.height) + static_cast<std::size_t>(y)) *
+                   static_cast<std::size_t>(size_.width) +
+               static_cast<std::size_t>(x);
+    }
+    SensorSize size_;
+    std::vector<std::int64_t> t_;
+};
+static_assert(Detector<CrossPolarity>);
+
+TEST(ParallelDetect, BothPolarityPartsForADetectorReadingBoth) {
+    const auto make = [](SensorSize z, int planes) { return CrossPolarity(z, planes); };
+    for (const SensorSize s : {SensorSize{240, 180}, SensorSize{1280, 720}, SensorSize{13, 9}}) {
+        SCOPED_TRACE(testing::Message() << s.width << "x" << s.height);
+        const auto events = random_stream(s, 120000, 17);
+        expect_same_as_one_thread<CrossPolarity>(events, s, Locality(CrossPolarity::kRadius, false), make, 30000,
+                                                 /*need_corners=*/s.width > 13);
+    }
+    // Split by polarity, the parts never see the other polarity: different flags (the
+    // stream does exercise the cross-polarity reads, so the test above could fail).
+    const SensorSize s{240, 180};
+    const auto events = random_stream(s, 120000, 17);
+    CrossPolarity one(s);
+    std::vector<std::uint8_t> expected(events.size()), wrong(events.size());
+    ASSERT_GT(detect(one, std::span<const Event>(events), expected), 0u);
+    ParallelDetector<CrossPolarity> par(s, 2, Locality(CrossPolarity::kRadius, true), make);
+    EXPECT_TRUE(par.split_polarity());
+    par.detect(std::span<const Event>(events), wrong);
+    EXPECT_NE(wrong, expected);
+}
+
+TEST(ParallelDetect, BothPolarityBandsCoverEachRowOnce) {
+    const SensorSize s{240, 180};
+    const auto events = random_stream(s, 20000, 3);
+    for (int bands = 1; bands <= 30; ++bands) {
+        const auto parts = plan_parts(s, bands, 4, events, /*split_polarity=*/false);
+        ASSERT_GE(parts.size(), 1u);
+        ASSERT_LE(parts.size(), static_cast<std::size_t>(bands));
+        for (const auto& part : parts) EXPECT_EQ(part.p, -1);
+        for (int p = 0; p < 2; ++p)
+            for (int y = 0; y < s.height; ++y) {
+                int owners = 0;
+                for (const auto& part : parts) owners += part.owns(p, y);
+                ASSERT_EQ(owners, 1) << bands << " bands, polarity " << p << ", row " << y;
+            }
+    }
+}
+
+// Every local detector of the registry, built and split as its entry says (what
+// evcorner detect --threads and bench --threads do), on a random stream.
+TEST(ParallelDetect, EveryLocalDetectorOfTheRegistry) {
+    const SensorSize s{320, 240};
+    const auto events = random_stream(s, 150000, 23);
+    int local = 0;
+    for_each_detector_entry([&](const auto& entry) {
+        using D = typename std::remove_cvref_t<decltype(entry)>::Detector;
+        if (entry.split == Split::none) return;
+        ++local;
+        SCOPED_TRACE(std::string(entry.name));
+        const auto params = entry.params_of({});
+        expect_same_as_one_thread<D>(events, s, Locality(entry.radius(params), entry.split == Split::by_polarity),
+                                     [&](SensorSize z, int planes) { return entry.make(z, params, planes); }, 40000);
+    });
+    EXPECT_GE(local, 2);
 }
 
 TEST(ParallelDetect, AnErrorAlongsideComesAfterTheBatch) {

@@ -13,8 +13,9 @@
 //    section (the clock's own overhead) is measured first and subtracted; it is printed.
 //    The timed pass runs slower than the throughput passes (the fences stop events from
 //    overlapping), so its percentiles bound a single event's latency from above.
-//  - --threads 1,2,...: efast and harris also run split over that many threads
-//    (parallel_detect.hpp), timed the same way; thread start-up is outside the timing.
+//  - --threads 1,2,...: the local detectors (the registry says which) also run split over
+//    that many threads (parallel_detect.hpp), timed the same way; thread start-up is
+//    outside the timing.
 // Data flows one way: the timing wraps the loop; the detectors know nothing of it.
 
 #include <algorithm>
@@ -36,8 +37,9 @@
 #endif
 
 #include "commands.hpp"
+#include "detector_options.hpp"
 #include "eval_common.hpp"
-#include "evcorner/any_detector.hpp"
+#include "evcorner/registry.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
@@ -60,7 +62,8 @@ using Clock = std::chrono::steady_clock;
 
 struct BenchOptions {
     std::vector<std::string> inputs;
-    std::string detectors = "efast,harris,harris-global";
+    std::string detectors = all_detectors_list();
+    ParamValues detector_params;
     int repeat = 5;
     std::uint64_t min_events = 10'000'000;
     std::string json;
@@ -260,7 +263,7 @@ Row bench_one(const std::string& input, const std::string& name, SensorSize sens
               Latency& clock, const PassDone& done) {
     Row row = timed_passes(input, name, 1, sensor, events, file_events, o.repeat,
                            [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
-                               AnyDetector any = make_detector(name, sensor);
+                               AnyDetector any = make_detector(config_for(name, o.detector_params), sensor, "--");
                                r.memory = memory_bytes(any);
                                std::visit(
                                    [&](auto& det) {
@@ -270,7 +273,7 @@ Row bench_one(const std::string& input, const std::string& name, SensorSize sens
                            },
                            done);
     if (!o.no_latency) {
-        AnyDetector any = make_detector(name, sensor);
+        AnyDetector any = make_detector(config_for(name, o.detector_params), sensor, "--");
         std::visit(
             [&](auto& det) {
                 const Latency l = time_each_event(det, events);
@@ -298,17 +301,18 @@ Row bench_parallel(const std::string& input, const std::string& name, int thread
                             },
                             done);
     };
-    if (name == "efast")
+    const DetectorConfig config = config_for(name, o.detector_params);
+    return with_detector_entry(name, [&](const auto& entry) {
+        using D = typename std::remove_cvref_t<decltype(entry)>::Detector;
+        if (entry.split == Split::none)
+            throw std::invalid_argument("--threads: detector '" + name + "' is not local (" + std::string(entry.not_local) + ")");
+        const auto params = entry.params_of(config.params, "--");
         return passes([&] {
-            return std::make_unique<ParallelDetector<EFast>>(sensor, threads, kCircleMargin,
-                                                             [](SensorSize s, int planes) { return EFast(s, planes); });
+            return std::make_unique<ParallelDetector<D>>(
+                sensor, threads, Locality(entry.radius(params), entry.split == Split::by_polarity),
+                [&entry, params](SensorSize s, int planes) { return entry.make(s, params, planes); });
         });
-    if (name == "harris")
-        return passes([&] {
-            return std::make_unique<ParallelDetector<Harris>>(sensor, threads, HarrisParams{}.window / 2,
-                                                              [](SensorSize s, int planes) { return Harris(s, {}, planes); });
-        });
-    throw std::invalid_argument("--threads: detector '" + name + "' is not local (efast and harris are)");
+    });
 }
 
 // ----------------------------------------------------------------- report
@@ -430,9 +434,9 @@ void run_bench(const BenchOptions& o) {
     }
     // With the JSON on standard output, the human-readable report goes to standard error.
     std::FILE* const out = o.json == "-" ? stderr : stdout;
-    const std::vector<std::string> detectors = split_list(o.detectors);
-    if (detectors.empty()) throw std::invalid_argument("-d: no detector named");
-    for (const auto& d : detectors) (void)make_detector(d, kDavis240);  // unknown names fail now
+    const std::vector<std::string> detectors = parse_detector_list(o.detectors);  // unknown names fail now
+    check_params_taken(detectors, o.detector_params, "--");
+    for (const auto& d : detectors) check_detector_config(config_for(d, o.detector_params), "--");
     std::vector<int> thread_counts;
     for (const auto& t : split_list(o.threads)) {
         const int k = std::atoi(t.c_str());
@@ -457,7 +461,7 @@ void run_bench(const BenchOptions& o) {
     std::uint64_t runs_per_input = 0;
     for (const std::string& d : detectors)
         for (const int thr : thread_counts) {
-            if (thr > 1 && d != "efast" && d != "harris") continue;
+            if (thr > 1 && !detector_info(d).local()) continue;
             runs_per_input += static_cast<std::uint64_t>(o.repeat) + (thr == 1 && !o.no_latency ? 1 : 0);
         }
     Progress progress(!o.quiet && !o.no_progress, runs_per_input * o.inputs.size());
@@ -487,7 +491,7 @@ void run_bench(const BenchOptions& o) {
         }
         for (const std::string& d : detectors)
             for (const int thr : thread_counts) {
-                if (thr > 1 && d != "efast" && d != "harris") continue;  // not local: one thread only
+                if (thr > 1 && !detector_info(d).local()) continue;  // not local: one thread only
                 rows.push_back(thr == 1 ? bench_one(input, d, sensor, stream, file_events, o, clock, done)
                                         : bench_parallel(input, d, thr, sensor, stream, file_events, o, done));
                 progress.finish();
@@ -518,7 +522,11 @@ void add_bench_command(CLI::App& app) {
         "(median, min, max), the maximum sustainable event rate, per-event latency\n"
         "percentiles (p50, p99, p99.9), detector memory, the CPU model and build flags.");
     cmd->add_option("FILE", o->inputs, "Event files (any format evcorner reads)")->required();
-    cmd->add_option("-d,--detectors", o->detectors, "Comma-separated detectors to run")->capture_default_str();
+    cmd->add_option("-d,--detectors", o->detectors,
+                    "Comma-separated detectors to run, or all [default: all registered, each with its defaults "
+                    "unless the parameter options below are given]:" +
+                        detectors_help());
+    add_param_options(*cmd, o->detector_params);
     cmd->add_option("--repeat", o->repeat, "Timed passes per detector and input")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
@@ -529,9 +537,13 @@ void add_bench_command(CLI::App& app) {
                     "Also write every figure as JSON to this file (- = standard output; the report then goes "
                     "to standard error)");
     add_load_options(*cmd, o->in);
+    std::string local;
+    for (const DetectorInfo& d : detector_infos())
+        if (d.local()) local += (local.empty() ? "" : ", ") + std::string(d.name);
     cmd->add_option("--threads", o->threads,
-                    "Comma-separated thread counts, e.g. 1,2: efast and harris also run split over that many "
-                    "threads (parallel_detect.hpp; no latency pass); others run on one")
+                    "Comma-separated thread counts, e.g. 1,2: the local detectors (" + local +
+                        ") also run split over that many threads (parallel_detect.hpp; no latency pass); others "
+                        "run on one")
         ->capture_default_str();
     cmd->add_flag("--no-latency", o->no_latency, "Skip the per-event latency pass");
     cmd->add_flag("-q,--quiet", o->quiet, "No per-run progress lines and no progress bar on standard error");
@@ -539,6 +551,7 @@ void add_bench_command(CLI::App& app) {
     cmd->footer(
         "Examples:\n"
         "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt\n"
+        "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt --min-events 1 --no-latency   # cold: one pass per file\n"
         "  evcorner bench recording.raw -d efast --repeat 9 --min-events 20000000 --json bench.json\n"
         "  evcorner bench hd.raw -d efast --threads 1,2          # multi-core speed-up");
     cmd->callback([o] { run_bench(*o); });

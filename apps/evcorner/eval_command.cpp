@@ -24,8 +24,9 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "detector_options.hpp"
 #include "eval_common.hpp"
-#include "evcorner/any_detector.hpp"
+#include "evcorner/registry.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/eval/metrics.hpp"
@@ -44,7 +45,8 @@ constexpr std::size_t kBatch = std::size_t{1} << 16;
 
 struct EvalOptions {
     std::vector<std::string> inputs;
-    std::string detectors = "efast,harris,harris-global";
+    std::string detectors = all_detectors_list();
+    ParamValues detector_params;
     int repeat = 5;
     std::string report;
     bool no_figures = false;
@@ -277,18 +279,6 @@ struct DetectorRuns {
     std::vector<Event> corners;   ///< the first detector's corner events
 };
 
-std::vector<std::string> split_detectors(const std::string& list) {
-    std::vector<std::string> out;
-    std::stringstream ss(list);
-    for (std::string d; std::getline(ss, d, ',');) {
-        if (d.empty()) continue;
-        make_detector(d, kDavis240);  // throws for an unknown name
-        out.push_back(d);
-    }
-    if (out.empty()) throw std::invalid_argument("-d: no detector named");
-    return out;
-}
-
 std::string cell(double v) { return std::isnan(v) ? "-" : fmt::format("{:.1f}", v); }
 
 std::string table1_text(const eval::Table1& t, bool markdown) {
@@ -388,7 +378,13 @@ std::string paper_comparison_md(const eval::Table1& t, const std::map<std::strin
 
 void run_eval(EvalOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
-    const std::vector<std::string> detectors = split_detectors(o.detectors);
+    const std::vector<std::string> detectors = parse_detector_list(o.detectors);
+    check_params_taken(detectors, o.detector_params, "--");
+    std::vector<DetectorConfig> configs;
+    for (const auto& d : detectors) {
+        configs.push_back(config_for(d, o.detector_params));
+        check_detector_config(configs.back(), "--");
+    }
     const std::vector<Sequence> seqs = find_sequences(o.inputs);
     fs::path fig_dir;
     if (!o.report.empty()) {
@@ -411,9 +407,9 @@ void run_eval(EvalOptions& o) {
         const auto reader = open_events(seq.file.string(), o.in);
         const SensorSize size = sensor_of(*reader);
         std::vector<DetectorRuns> kinds;
-        for (const auto& dname : detectors) {
-            DetectorRuns k{dname, {}, std::vector<double>(static_cast<std::size_t>(o.repeat), 0.0), {}};
-            for (int rep = 0; rep < o.repeat; ++rep) k.detectors.push_back(make_detector(dname, size));
+        for (const DetectorConfig& config : configs) {
+            DetectorRuns k{config.name, {}, std::vector<double>(static_cast<std::size_t>(o.repeat), 0.0), {}};
+            for (int rep = 0; rep < o.repeat; ++rep) k.detectors.push_back(make_detector(config, size, "--"));
             kinds.push_back(std::move(k));
         }
         std::unique_ptr<StreamFigures> figs;
@@ -572,7 +568,19 @@ void add_eval_command(CLI::App& app) {
                     "its <sequence>/events.txt folders and its event files (.txt .csv .npy .aedat .aedat2 "
                     ".aedat4 .raw .dat .h5 .hdf5), other files skipped with a note")
         ->required();
-    cmd->add_option("-d,--detectors", o->detectors, "Comma-separated detectors")->capture_default_str();
+    cmd->add_option("-d,--detectors", o->detectors,
+                    "Comma-separated detectors, or all [default: all, each with its defaults (the paper's for "
+                    "efast, harris and harris-global)]:" +
+                        detectors_help())
+        ->check([](const std::string& list) {
+            try {
+                (void)parse_detector_list(list);
+                return std::string();
+            } catch (const std::invalid_argument& e) {
+                return std::string(e.what());
+            }
+        });
+    add_param_options(*cmd, o->detector_params);
     cmd->add_option("--repeat", o->repeat, "Timed runs per detector and sequence (median)")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
@@ -585,7 +593,8 @@ void add_eval_command(CLI::App& app) {
     cmd->footer(
         "Examples:\n"
         "  evcorner eval ../shared/data/real/ecd-stppp --report eval-report\n"
-        "  evcorner eval a/events.txt b.txt -d efast,harris --repeat 3");
+        "  evcorner eval a/events.txt b.txt -d efast,harris --repeat 3\n"
+        "  evcorner eval ../shared/data/real/ecd-stppp -d all --harris-window 7 --no-figures");
     cmd->callback([o] { run_eval(*o); });
 }
 

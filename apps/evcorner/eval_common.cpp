@@ -75,9 +75,8 @@ void finish_feature_track_params(eval::FeatureTrackParams& p, const std::string&
     eval::validate(p);
 }
 
-std::vector<Event> detect_corners(const std::string& detector, const std::vector<Event>& events, SensorSize size,
-                                  const DetectorParams& params) {
-    AnyDetector det = make_detector(detector, size, params);
+std::vector<Event> detect_corners(const DetectorConfig& detector, const std::vector<Event>& events, SensorSize size) {
+    AnyDetector det = make_detector(detector, size, "--");
     std::vector<std::uint8_t> flags(events.size());
     std::visit([&](auto& d) { detect(d, std::span<const Event>(events), flags); }, det);
     std::vector<Event> corners;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "evcorner/any_detector.hpp"
+#include "evcorner/registry.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/event.hpp"
 #include "evcorner/io/event_reader.hpp"
@@ -49,8 +49,7 @@ void add_feature_track_options(CLI::App& cmd, eval::FeatureTrackParams& p, std::
 void finish_feature_track_params(eval::FeatureTrackParams& p, const std::string& overlap);
 
 /// The corner events `detector` finds in `events` (a fresh detector).
-std::vector<Event> detect_corners(const std::string& detector, const std::vector<Event>& events, SensorSize size,
-                                  const DetectorParams& params = {});
+std::vector<Event> detect_corners(const DetectorConfig& detector, const std::vector<Event>& events, SensorSize size);
 
 /// A time option: seconds on the stream's clock ("51.99"), or "+S" seconds after
 /// `first_us`, or "-S" seconds before `last_us`. Throws std::invalid_argument.

@@ -26,8 +26,9 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "detector_options.hpp"
 #include "eval_common.hpp"
-#include "evcorner/any_detector.hpp"
+#include "evcorner/registry.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/error.hpp"
 #include "evcorner/io/open.hpp"
@@ -56,6 +57,7 @@ struct RenderOptions {
     std::string output;
     std::string kind = "corners";
     std::string detector = "efast";
+    ParamValues detector_params;
     std::string corners_file;
     std::string at;
     double window_ms = 0;  // 0: the kind's default
@@ -199,7 +201,7 @@ Kept stream_input(const RenderOptions& o, const Need& need, bool detect_here) {
     Kept k;
     k.size = sensor_of(*reader);
     std::optional<AnyDetector> detector;
-    if (detect_here) detector = make_detector(o.detector, k.size);
+    if (detect_here) detector = make_detector(DetectorConfig{o.detector, o.detector_params}, k.size, "--");
     // --at known from the first event on (seconds, "+S"), or only at the end (absent, "-S").
     const bool at_from_end = o.at.empty() || o.at[0] == '-';
     const std::int64_t back_from_end =
@@ -293,7 +295,9 @@ std::vector<Event> stream_corners_file(const RenderOptions& o, std::int64_t lo, 
 
 std::string detector_text(const RenderOptions& o) {
     if (!o.corners_file.empty()) return "corner events from " + shown_name(o.corners_file);
-    return "detector " + o.detector;
+    std::string s = "detector " + o.detector;
+    for (const auto& [key, value] : o.detector_params) s += " " + key + "=" + format_param_value(value);
+    return s;
 }
 
 // A PNG goes to a file named *.png, or to a device or pipe that already exists (/dev/null,
@@ -317,6 +321,11 @@ void run_render(RenderOptions& o) {
     if (!o.at.empty()) (void)parse_time_option(o.at, 0, 0);  // its syntax, before reading anything
     const Need need = need_for(o);
     const bool from_file = !o.corners_file.empty();
+    // Parameters are checked before reading anything, and refused where nothing is detected.
+    if (!o.detector_params.empty() && (!need.corners || from_file))
+        throw std::invalid_argument("detector parameters given, but this figure runs no detector (" +
+                                    std::string(from_file ? "--corners" : "-k " + o.kind) + ")");
+    if (need.corners && !from_file) check_detector_config(DetectorConfig{o.detector, o.detector_params}, "--");
     Kept k = stream_input(o, need, need.corners && !from_file);
     const std::int64_t at = k.at;
 
@@ -446,13 +455,8 @@ void add_render_command(CLI::App& app) {
     cmd->add_option("-k,--kind", o->kind, "sae, corners, space-time or labels")
         ->capture_default_str()
         ->check(CLI::IsMember({"sae", "corners", "space-time", "labels"}));
-    cmd->add_option("-d,--detector", o->detector, "Detector for the corner events")
-        ->capture_default_str()
-        ->check([](const std::string& name) {
-            for (const auto& d : detector_infos())
-                if (d.name == name) return std::string();
-            return "unknown detector '" + name + "'";
-        });
+    add_detector_option(*cmd, o->detector, "Detector for the corner events:" + detectors_help());
+    add_param_options(*cmd, o->detector_params);
     cmd->add_option("--corners", o->corners_file, "Take the corner events from this file instead of detecting");
     cmd->add_option("--at", o->at,
                     "Time drawn (end of the interval): seconds on the stream's clock, +S after the first "

@@ -26,8 +26,12 @@
 
 namespace evcorner {
 
+/// eFAST has no parameters: the paper fixes its circles and arc lengths.
+struct EFastParams {};
+
 class EFast {
 public:
+    using Params = EFastParams;
     static constexpr int kArc3Min = 3, kArc3Max = 6;
     static constexpr int kArc4Min = 4, kArc4Max = 8;
 
@@ -35,10 +39,16 @@ public:
     /// events of one polarity (ParallelDetector's parts), at half the memory. Throws
     /// std::invalid_argument for a side outside 1..kMaxSensorSide.
     explicit EFast(SensorSize size, int planes = 2) : sae_(checked_sensor_size(size, "eFAST"), planes) {}
+    /// The detector contract's form (registry.hpp): eFAST has no parameters.
+    EFast(SensorSize size, const EFastParams& /*params*/, int planes = 2) : EFast(size, planes) {}
 
     /// Bytes of state a detector over `size` holds (8 per pixel and plane), allocated
     /// as zero pages that are committed only where events land.
     [[nodiscard]] static constexpr std::uint64_t state_bytes(SensorSize size, int planes = 2) noexcept {
+        return Sae::state_bytes(size, planes);
+    }
+    [[nodiscard]] static constexpr std::uint64_t state_bytes(SensorSize size, const EFastParams& /*params*/,
+                                                             int planes = 2) noexcept {
         return Sae::state_bytes(size, planes);
     }
 

@@ -32,6 +32,7 @@ struct HarrisParams {
 
 class Harris {
 public:
+    using Params = HarrisParams;
     /// Throws std::invalid_argument for a parameter or a sensor side out of range (the
     /// message names it). `planes` = 1 keeps one plane of state for both polarities: only
     /// for a caller that feeds events of one polarity (ParallelDetector's parts), at half

@@ -36,6 +36,7 @@ struct HarrisGlobalParams {
 
 class HarrisGlobal {
 public:
+    using Params = HarrisGlobalParams;
     /// Throws std::invalid_argument for a parameter or a sensor side out of range (the
     /// message names it).
     explicit HarrisGlobal(SensorSize size, HarrisGlobalParams params = {});

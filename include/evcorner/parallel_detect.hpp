@@ -2,16 +2,20 @@
 // Running a local detector on several threads with output identical to one thread.
 //
 // A detector is *local* with radius r when whether event e is a corner depends only on
-// the earlier events of e's polarity within r pixels of e (eFAST: r = 4, the radius-4
-// circle; Harris: half its window). Then the sensor splits into parts, each a band of
-// rows [y0, y1) of one polarity p: a part keeps its own detector, over a sensor of just
-// the rows [y0 - r, y1 + r) (the band and its halo, clipped to the sensor) and with one
-// state plane (it sees one polarity), feeds it, in
-// input order, every event of polarity p in those rows, and keeps its answers only for
-// the events of its band. Each event is classified by exactly one part, from a state
-// identical to that of a single detector run over the whole stream (the border rule
-// sees the same distances: a halo is at least the detector's border margin), so the flags
-// are identical, in input order, for any number of threads.
+// the earlier events within r pixels of e (eFAST: r = 4, the radius-4 circle; Harris:
+// half its window). Then the sensor splits into parts, each a band of rows [y0, y1): a
+// part keeps its own detector, over a sensor of just the rows [y0 - r, y1 + r) (the band
+// and its halo, clipped to the sensor), feeds it, in input order, every event of its
+// part in those rows, and keeps its answers only for the events of its band. Two ways
+// to split (Locality::split_polarity, from the registry's entry):
+//  - by polarity: when a decision reads only the events of e's own polarity (eFAST,
+//    Harris), each part takes one polarity, and its detector keeps one state plane;
+//  - by rows only: when a decision also reads the other polarity, each part takes both
+//    polarities of its rows, and its detector keeps both planes.
+// Each event is classified by exactly one part, from a state identical to that of a
+// single detector run over the whole stream (the border rule sees the same distances: a
+// halo is at least the detector's border margin), so the flags are identical, in input
+// order, for any number of threads.
 //
 // Parts outnumber threads (by default four per thread) and are handed out per batch,
 // largest first, to whichever thread is free: the load balances however the events move
@@ -63,19 +67,29 @@ private:
     std::unique_ptr<State> state_;
 };
 
-/// One part of the sensor: the band of rows [y0, y1) of polarity p, and the rows
-/// [lo, hi) its detector covers (the band and its halo, clipped to the sensor).
+/// How a local detector may be split: its radius, and whether a part may take one
+/// polarity (true: its decisions read their own polarity only) or must take both.
+struct Locality {
+    int radius = 0;
+    bool split_polarity = true;
+    constexpr Locality(int r, bool by_polarity = true) noexcept : radius(r), split_polarity(by_polarity) {}
+};
+
+/// One part of the sensor: the band of rows [y0, y1) of polarity p (p = -1: both), and
+/// the rows [lo, hi) its detector covers (the band and its halo, clipped to the sensor).
 struct DetectPart {
     int p = 0;
     int y0 = 0, y1 = 0;
     int lo = 0, hi = 0;
-    [[nodiscard]] bool owns(int pol, int y) const noexcept { return pol == p && y >= y0 && y < y1; }
+    [[nodiscard]] bool owns(int pol, int y) const noexcept { return (p < 0 || pol == p) && y >= y0 && y < y1; }
 };
 
-/// Cuts each polarity's rows into at most `bands` bands holding similar numbers of
-/// `sample`'s events, each at least max(1, 2 * radius) rows high (fewer bands on a short
-/// sensor). Returns the OFF bands top to bottom, then the ON bands.
-std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::span<const Event> sample);
+/// Cuts the rows into at most `bands` bands holding similar numbers of `sample`'s events,
+/// each at least max(1, 2 * radius) rows high (fewer bands on a short sensor). With
+/// `split_polarity`, each polarity's rows separately: the OFF bands top to bottom, then
+/// the ON bands; else bands of both polarities (p = -1), top to bottom.
+std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::span<const Event> sample,
+                                   bool split_polarity = true);
 
 namespace detail {
 // The detector's batch loops: unqualified calls, so that argument-dependent lookup
@@ -106,21 +120,26 @@ public:
     static constexpr std::size_t kMaxBatch = std::size_t{1} << 16;
 
     /// `make(SensorSize, planes)` builds one detector: over the whole sensor with one state
-    /// plane per polarity (planes = 2) for a single thread, or over a part's rows with one
-    /// plane (planes = 1: a part sees one polarity). `radius` is the detector's locality;
+    /// plane per polarity (planes = 2) for a single thread, or over a part's rows, with one
+    /// plane (planes = 1) when the parts split by polarity, else two. `locality` is the
+    /// detector's radius and split (an int: that radius, split by polarity);
     /// `parts_per_thread` parts per thread are handed out per batch.
     template <class Make>
-    ParallelDetector(SensorSize size, int threads, int radius, Make make, int parts_per_thread = 4)
-        : size_(checked_sensor_size(size, "ParallelDetector")), radius_(radius),
-          parts_per_thread_(std::max(1, parts_per_thread)), pool_(std::max(1, threads)), make_(std::move(make)) {
+    ParallelDetector(SensorSize size, int threads, Locality locality, Make make, int parts_per_thread = 4)
+        : size_(checked_sensor_size(size, "ParallelDetector")), radius_(locality.radius),
+          split_polarity_(locality.split_polarity), parts_per_thread_(std::max(1, parts_per_thread)),
+          pool_(std::max(1, threads)), make_(std::move(make)) {
         if (pool_.size() == 1) {
             single_ = std::make_unique<D>(make_(size_, 2));
             limits_ = single_->limits();
         } else {
-            limits_ = make_(SensorSize{1, 1}, 1).limits();  // the detector's time range
+            limits_ = make_(SensorSize{1, 1}, part_planes()).limits();  // the detector's time range
             limits_.size = size_;
         }
     }
+
+    /// Whether parts take one polarity each.
+    [[nodiscard]] bool split_polarity() const noexcept { return split_polarity_; }
 
     /// What detect() and prepare() accept (the detector's limits over the whole sensor).
     [[nodiscard]] const EventLimits& limits() const noexcept { return limits_; }
@@ -236,20 +255,28 @@ private:
         std::vector<std::uint32_t> order;  // parts with events, largest first
     };
 
+    [[nodiscard]] int part_planes() const noexcept { return split_polarity_ ? 1 : 2; }
+
     void make_parts(std::span<const Event> sample) {
-        const int bands = std::clamp(pool_.size() * parts_per_thread_ / 2, 1, 256);
-        plan_ = plan_parts(size_, bands, radius_, sample);
+        // 512 parts at most (scatter's tables): 256 bands per polarity, or 512 of both.
+        const int bands = split_polarity_ ? std::clamp(pool_.size() * parts_per_thread_ / 2, 1, 256)
+                                          : std::clamp(pool_.size() * parts_per_thread_, 1, 512);
+        plan_ = plan_parts(size_, bands, radius_, sample, split_polarity_);
         const std::size_t P = plan_.size();
         const std::size_t H = static_cast<std::size_t>(size_.height);
         main_of_.assign(2 * H, 0);
         halo_of_.assign(2 * H, static_cast<std::uint16_t>(P));  // P: in no halo
         for (std::size_t j = 0; j < P; ++j) {
             const DetectPart& d = plan_[j];
-            for (int y = d.y0; y < d.y1; ++y) main_of_[static_cast<std::size_t>(d.p) * H + static_cast<std::size_t>(y)] = static_cast<std::uint16_t>(j);
-            for (int y = d.lo; y < d.hi; ++y)
-                if (y < d.y0 || y >= d.y1) halo_of_[static_cast<std::size_t>(d.p) * H + static_cast<std::size_t>(y)] = static_cast<std::uint16_t>(j);
+            for (int p = 0; p < 2; ++p) {
+                if (d.p >= 0 && d.p != p) continue;
+                const std::size_t at = static_cast<std::size_t>(p) * H;
+                for (int y = d.y0; y < d.y1; ++y) main_of_[at + static_cast<std::size_t>(y)] = static_cast<std::uint16_t>(j);
+                for (int y = d.lo; y < d.hi; ++y)
+                    if (y < d.y0 || y >= d.y1) halo_of_[at + static_cast<std::size_t>(y)] = static_cast<std::uint16_t>(j);
+            }
             Part part;
-            part.detector = std::make_unique<D>(make_(SensorSize{size_.width, d.hi - d.lo}, 1));
+            part.detector = std::make_unique<D>(make_(SensorSize{size_.width, d.hi - d.lo}, part_planes()));
             part.lo = d.lo;
             part.flags.reserve(kMaxBatch);
             part.corners.reserve(kMaxBatch);
@@ -328,6 +355,7 @@ private:
     SensorSize size_;
     EventLimits limits_;
     int radius_;
+    bool split_polarity_;
     int parts_per_thread_;
     WorkerPool pool_;
     std::function<D(SensorSize, int)> make_;

@@ -1,0 +1,209 @@
+#pragma once
+// Every detector evcorner runs, in ONE place: detector_registry() below. Adding a
+// detector is one #include and one DetectorEntry in that list (docs/detectors.md);
+// every command (detect, eval, render, bench, --threads, --help), the detection
+// pipeline (pipeline/detect.hpp) and AnyDetector take it from here.
+//
+// Picking a detector at run time: AnyDetector is a std::variant of the listed classes,
+// visited once outside the per-event loop, so that the loop itself is statically
+// dispatched; with_detector_entry() hands a generic lambda the entry of a named
+// detector, to build loops (or a ParallelDetector) on its concrete class.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "evcorner/detector_config.hpp"
+#include "evcorner/detector_entry.hpp"
+#include "evcorner/sensor.hpp"
+
+// The detectors.
+#include "evcorner/efast.hpp"
+#include "evcorner/harris.hpp"
+#include "evcorner/harris_global.hpp"
+
+namespace evcorner {
+
+/// THE list: one entry per detector, in the order --help lists them. Keys of parameters
+/// are global: a key several detectors take (harris-window) means the same thing for
+/// each and has the same type.
+// Entries name only the fields they need (the others keep DetectorEntry's defaults).
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#endif
+inline const auto& detector_registry() {
+    static const std::tuple entries{
+        DetectorEntry<EFast>{
+            .name = "efast",
+            .summary = "eFAST (Mueggler et al., BMVC 2017): arcs on the SAE circles of radius 3 and 4",
+            .params = {},
+            .split = Split::by_polarity,
+            .radius = [](const EFastParams&) { return kCircleMargin; },
+        },
+        DetectorEntry<Harris>{
+            .name = "harris",
+            .summary = "spatially-adaptive Harris (Mueggler et al., BMVC 2017, Sec. 3.2): newest Nl pixels of the window",
+            .params =
+                {
+                    param("harris-window", &HarrisParams::window, 5, 15, "patch side, odd"),
+                    param("harris-nl", &HarrisParams::nl, 1, 225, "newest distinct pixels lit in the patch, at most window^2"),
+                    param("harris-k", &HarrisParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
+                    param("harris-threshold", &HarrisParams::threshold, -kUnbounded, kUnbounded, "corner iff score > threshold"),
+                },
+            .split = Split::by_polarity,
+            .radius = [](const HarrisParams& p) { return p.window / 2; },
+        },
+        DetectorEntry<HarrisGlobal>{
+            .name = "harris-global",
+            .summary = "event-based Harris (Vasco et al., IROS 2016): newest N pixels of the sensor",
+            .params =
+                {
+                    param("harris-window", &HarrisGlobalParams::window, 5, 15, "patch side, odd"),
+                    param("harris-n", &HarrisGlobalParams::n, 1, 2147483647,
+                          "newest distinct pixels lit over the sensor per polarity (1000 or 2000 in Vasco et al.)"),
+                    param("harris-k", &HarrisGlobalParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
+                    param("harris-threshold", &HarrisGlobalParams::threshold, -kUnbounded, kUnbounded,
+                          "corner iff score > threshold"),
+                },
+            .split = Split::none,
+            .not_local = "its surface holds the newest N pixels of the whole sensor",
+        },
+    };
+    return entries;
+}
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+namespace detail {
+template <class Entries>
+struct DetectorVariant;
+template <class... E>
+struct DetectorVariant<std::tuple<E...>> {
+    using type = std::variant<typename E::Detector...>;
+};
+}  // namespace detail
+
+/// Any detector of the registry.
+using AnyDetector = detail::DetectorVariant<std::remove_cvref_t<decltype(detector_registry())>>::type;
+
+/// Calls f(entry) for every entry, in order.
+template <class F>
+void for_each_detector_entry(F&& f) {
+    std::apply([&](const auto&... e) { (f(e), ...); }, detector_registry());
+}
+
+/// [[noreturn]]: "unknown detector 'x' (known: efast, harris, harris-global)".
+[[noreturn]] void throw_unknown_detector(std::string_view name);
+
+/// Returns f(entry) for the entry called `name` (f: a generic lambda taking `const
+/// DetectorEntry<D>&`; every instantiation must return the same type); throws
+/// std::invalid_argument for an unknown name.
+template <class F>
+decltype(auto) with_detector_entry(std::string_view name, F&& f) {
+    using R = decltype(f(std::get<0>(detector_registry())));
+    if constexpr (std::is_void_v<R>) {
+        bool found = false;
+        for_each_detector_entry([&](const auto& e) {
+            if (!found && e.name == name) {
+                found = true;
+                f(e);
+            }
+        });
+        if (!found) throw_unknown_detector(name);
+    } else {
+        std::optional<R> out;
+        for_each_detector_entry([&](const auto& e) {
+            if (!out && e.name == name) out.emplace(f(e));
+        });
+        if (!out) throw_unknown_detector(name);
+        return R(std::move(*out));
+    }
+}
+
+// ------------------------------------------------------------------ run-time view
+
+/// Every detector, in the registry's order.
+std::span<const DetectorInfo> detector_infos();
+/// The detector called `name`; throws std::invalid_argument for an unknown name.
+const DetectorInfo& detector_info(std::string_view name);
+/// "efast, harris, harris-global".
+std::string detector_names(std::string_view separator = ", ");
+
+/// One parameter key as all the detectors that take it see it.
+struct ParamKeyInfo {
+    std::string_view key;
+    ParamType type = ParamType::integer;
+    std::string_view help;                 ///< the first detector's
+    std::vector<std::string_view> detectors;  ///< the detectors that take it, in order
+    std::vector<ParamValue> defaults;         ///< their defaults, in the same order
+};
+/// Every distinct key, in order of first appearance. Throws std::logic_error when two
+/// detectors give one key different types (a registry bug; a test checks).
+std::vector<ParamKeyInfo> parameter_keys();
+
+/// Reads `text` as a value of parameter `key` ("11", "0.04", "true"/"false"/"1"/"0");
+/// throws std::invalid_argument (naming prefix + key) for an unknown key or a bad value.
+ParamValue parse_param_value(std::string_view key, std::string_view text, std::string_view prefix = "");
+/// Reads "KEY=VALUE" (the command line's -p) into `values`.
+void parse_param_assignment(std::string_view assignment, ParamValues& values, std::string_view prefix = "");
+
+/// Throws std::invalid_argument when `config` names an unknown detector, a key that
+/// detector does not take, or a value of the wrong type or out of range (messages name
+/// the key as prefix + key). Parameters whose valid range depends on another (Harris's
+/// nl <= window^2) are checked when the detector is built.
+void check_detector_config(const DetectorConfig& config, std::string_view prefix = "");
+
+/// The values of `values` that detector `name` takes (for commands that run several
+/// detectors with one set of options).
+DetectorConfig config_for(std::string_view name, const ParamValues& values);
+
+/// Throws std::invalid_argument when a key of `values` is taken by none of `names`.
+void check_params_taken(std::span<const std::string> names, const ParamValues& values, std::string_view prefix = "");
+
+/// Bytes of state the configured detector needs over `size` (its static state_bytes());
+/// throws as check_detector_config() does.
+std::uint64_t detector_state_bytes(const DetectorConfig& config, SensorSize size);
+inline std::uint64_t detector_state_bytes(std::string_view name, SensorSize size) {
+    return detector_state_bytes(DetectorConfig{std::string(name), {}}, size);
+}
+
+/// The locality radius for --threads (parallel_detect.hpp), or nullopt when the detector
+/// is not local; throws as check_detector_config() does.
+std::optional<int> detector_radius(const DetectorConfig& config);
+
+/// Builds the configured detector; throws std::invalid_argument for an unknown name, a
+/// parameter out of range or a sensor side outside 1..kMaxSensorSide, and, before
+/// allocating, StateTooLarge (state_memory.hpp) when its state needs more memory than
+/// available_memory_bytes() (e.g. "a 65536x65536 sensor needs 68.7 GB for efast's state
+/// (16 B per pixel); 21.3 GB is available").
+AnyDetector make_detector(const DetectorConfig& config, SensorSize size, std::string_view prefix = "");
+inline AnyDetector make_detector(std::string_view name, SensorSize size) {
+    return make_detector(DetectorConfig{std::string(name), {}}, size);
+}
+
+/// The registry name of the detector `d` holds.
+std::string_view detector_name(const AnyDetector& d) noexcept;
+
+/// detect() on whichever detector `d` holds (checked; see detector.hpp).
+std::size_t detect(AnyDetector& d, std::span<const Event> events, std::span<std::uint8_t> is_corner);
+/// detect_unchecked() on whichever detector `d` holds.
+std::size_t detect_unchecked(AnyDetector& d, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+
+/// Whether the detector reports a score (ScoredDetector).
+bool has_score(const AnyDetector& d) noexcept;
+
+/// Bytes of state the detector holds.
+std::size_t memory_bytes(const AnyDetector& d) noexcept;
+
+}  // namespace evcorner
