@@ -49,7 +49,7 @@ void check_param_range(std::string_view prefix, std::string_view key, double v, 
 template <class P>
 struct ParamField {
     std::string_view key;
-    std::variant<int P::*, double P::*, bool P::*> member;
+    std::variant<int P::*, std::int64_t P::*, double P::*, bool P::*> member;
     double min = 0, max = 0;
     std::string_view help;
 
@@ -64,7 +64,7 @@ struct ParamField {
             std::visit(
                 [&](auto m) {
                     using T = std::remove_cvref_t<decltype(defaults.*m)>;
-                    if constexpr (std::is_same_v<T, int>) {
+                    if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>) {
                         i.type = ParamType::integer;
                         i.default_value = static_cast<std::int64_t>(defaults.*m);
                     } else if constexpr (std::is_same_v<T, double>) {
@@ -87,10 +87,10 @@ struct ParamField {
             std::visit(
                 [&](auto m) {
                     using T = std::remove_cvref_t<decltype(p.*m)>;
-                    if constexpr (std::is_same_v<T, int>) {
+                    if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::int64_t>) {
                         const std::int64_t x = detail::param_as_integer(prefix, key, v);
                         detail::check_param_range(prefix, key, static_cast<double>(x), min, max);
-                        p.*m = static_cast<int>(x);
+                        p.*m = static_cast<T>(x);
                     } else if constexpr (std::is_same_v<T, double>) {
                         const double x = detail::param_as_real(prefix, key, v);
                         detail::check_param_range(prefix, key, x, min, max);
@@ -107,6 +107,12 @@ struct ParamField {
 /// An integer parameter within [min, max].
 template <class P>
 ParamField<P> param(std::string_view key, int P::*member, int min, int max, std::string_view help) {
+    return {key, member, static_cast<double>(min), static_cast<double>(max), help};
+}
+/// A 64-bit integer parameter within [min, max] (times in microseconds, counts).
+template <class P>
+ParamField<P> param(std::string_view key, std::int64_t P::*member, std::int64_t min, std::int64_t max,
+                    std::string_view help) {
     return {key, member, static_cast<double>(min), static_cast<double>(max), help};
 }
 /// A real parameter within [min, max] (finite; +-infinity bounds: any finite value).

@@ -9,6 +9,7 @@
 // dispatched; with_detector_entry() hands a generic lambda the entry of a named
 // detector, to build loops (or a ParallelDetector) on its concrete class.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -30,6 +31,10 @@
 #include "evcorner/efast.hpp"
 #include "evcorner/harris.hpp"
 #include "evcorner/harris_global.hpp"
+#include "evcorner/arcstar.hpp"
+#include "evcorner/fa_harris.hpp"
+#include "evcorner/efast_harris.hpp"
+#include "evcorner/luvharris.hpp"
 
 namespace evcorner {
 
@@ -77,6 +82,91 @@ inline const auto& detector_registry() {
                 },
             .split = Split::none,
             .not_local = "its surface holds the newest N pixels of the whole sensor",
+        },
+        DetectorEntry<ArcStar>{
+            .name = "arcstar",
+            .summary = "Arc* (Alzugaray and Chli, RA-L 2018): 50 ms filter, then its arc test on the radius-3/4 circles, "
+                       "majority arcs included",
+            .params =
+                {
+                    param("arc-filter", &ArcStarParams::filter, "the published filter (false: every event passes)"),
+                    param("arc-filter-us", &ArcStarParams::filter_us, std::int64_t{0}, ArcStar::kMaxFilterUs,
+                          "filter window in us: an event passes when its pixel's last one is older by more"),
+                    param("arc-minority-only", &ArcStarParams::minority_only,
+                          "accept only minority arcs (3..6, 4..8), not the majority arcs"),
+                    param("arc-zero-init", &ArcStarParams::zero_init,
+                          "the authors' zero-initialised filter (a never-fired pixel reads as t = 0)"),
+                },
+            .split = Split::by_rows,
+            .radius = [](const ArcStarParams&) { return kCircleMargin; },
+        },
+        DetectorEntry<FaHarris>{
+            .name = "fa-harris",
+            .summary = "FA-Harris (Li et al., IROS 2019): Arc* candidates refined by the adaptive Harris on the newest "
+                       "filtered pixels",
+            .params =
+                {
+                    param("arc-filter", &FaHarrisParams::filter, "the published filter (false: every event passes)"),
+                    param("arc-filter-us", &FaHarrisParams::filter_us, std::int64_t{0}, ArcStar::kMaxFilterUs,
+                          "filter window in us: an event passes when its pixel's last one is older by more"),
+                    param("arc-minority-only", &FaHarrisParams::minority_only,
+                          "accept only minority arcs (3..6, 4..8), not the majority arcs"),
+                    param("arc-zero-init", &FaHarrisParams::zero_init,
+                          "the authors' zero-initialised filter (a never-fired pixel reads as t = 0)"),
+                    param("harris-window", &FaHarrisParams::window, 5, 15, "patch side, odd"),
+                    param("harris-nl", &FaHarrisParams::nl, 1, 225, "newest distinct pixels lit in the patch, at most window^2"),
+                    param("harris-k", &FaHarrisParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
+                    param("harris-threshold", &FaHarrisParams::threshold, -kUnbounded, kUnbounded, "corner iff score > threshold"),
+                },
+            .split = Split::by_rows,
+            .radius = [](const FaHarrisParams& p) { return std::max(kCircleMargin, p.window / 2); },
+        },
+        DetectorEntry<EFastHarris>{
+            .name = "efast-harris",
+            .summary = "eFAST -> Harris cascade (Mueggler et al., BMVC 2017, Sec. 4): eFAST corners the adaptive Harris "
+                       "also scores above its threshold",
+            .params =
+                {
+                    param("harris-window", &HarrisParams::window, 5, 15, "patch side, odd"),
+                    param("harris-nl", &HarrisParams::nl, 1, 225, "newest distinct pixels lit in the patch, at most window^2"),
+                    param("harris-k", &HarrisParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
+                    param("harris-threshold", &HarrisParams::threshold, -kUnbounded, kUnbounded, "corner iff score > threshold"),
+                },
+            .split = Split::by_polarity,
+            .radius = [](const HarrisParams& p) { return std::max(kCircleMargin, p.window / 2); },
+        },
+        DetectorEntry<LuvHarris>{
+            .name = "luvharris",
+            .summary = "luvHarris (Glover et al., TPAMI 2021): TOS surface, Harris table refreshed at fixed points of the "
+                       "stream (reproducible)",
+            .params =
+                {
+                    param("luv-tos-size", &LuvHarrisParams::tos_size, 3, 31, "TOS neighbourhood side k, odd"),
+                    param("luv-tos-threshold", &LuvHarrisParams::tos_threshold, 0, 254,
+                          "TOS T: values below 255 - k*T drop to 0 (at most 254/k)"),
+                    param("luv-gradient", &LuvHarrisParams::gradient, 3, 5,
+                          "derivative kernel side: 5 (the paper's Harris kernels) or 3 (Sobel)"),
+                    param("luv-block", &LuvHarrisParams::block, 1, 15,
+                          "structure-tensor block side, odd (box: 1..15, gaussian: 3..9)"),
+                    param("luv-gaussian-block", &LuvHarrisParams::gaussian_block, "binomial block weights instead of a box"),
+                    param("luv-k", &LuvHarrisParams::k, 0.0, 0.25, "Harris k (rounded to a multiple of 2^-16)"),
+                    param("luv-refresh-us", &LuvHarrisParams::refresh_us, std::int64_t{0}, LuvHarris::kMaxRefreshUs,
+                          "refresh the table every this much event time (0: never by time)"),
+                    param("luv-refresh-events", &LuvHarrisParams::refresh_events, std::int64_t{0},
+                          std::int64_t{1} << 40, "refresh the table every this many events (0: never by count)"),
+                    param("luv-adaptive", &LuvHarrisParams::adaptive,
+                          "threshold = running mean + sigmas * std of the looked-up values (false: luv-threshold)"),
+                    param("luv-sigmas", &LuvHarrisParams::sigmas, -kUnbounded, kUnbounded,
+                          "adaptive: standard deviations above the mean"),
+                    param("luv-alpha", &LuvHarrisParams::alpha, 0.0, 1.0,
+                          "adaptive: weight of each new value in the running statistics, (0, 1]"),
+                    param("luv-threshold", &LuvHarrisParams::threshold, -kUnbounded, kUnbounded,
+                          "fixed rule: corner iff the looked-up value > threshold"),
+                    param("luv-replicate-border", &LuvHarrisParams::replicate_border,
+                          "beyond the sensor the TOS reads as its nearest pixel (else 0)"),
+                },
+            .split = Split::none,
+            .not_local = "its look-up table is refreshed over the whole sensor at points of the whole stream",
         },
     };
     return entries;
