@@ -40,8 +40,9 @@ struct DetectOptions {
     std::string format = "auto";
     std::string to = "auto";
     std::string csv_columns;
-    std::string time_unit = "us";
+    std::string time_unit;
     std::string chip;
+    MoreInputOptions more;
     std::string size;
     std::string mask;
     std::string summary_json;
@@ -143,6 +144,7 @@ void run_detect(const DetectOptions& o) {
     ropts.csv_columns = o.csv_columns;
     ropts.csv_time_unit = o.time_unit;
     ropts.aedat2_chip = o.chip;
+    o.more.apply(ropts);
     const std::unique_ptr<io::EventReader> source = io::open_event_reader(o.input, ropts, o.format);
     io::EventReader& reader = *source;
     const SensorSize size = reader.sensor().value_or(kDavis240);
@@ -361,6 +363,7 @@ void add_detect_command(CLI::App& app) {
         ->capture_default_str();
     add_output_format_option(*cmd, o->to);
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
+    add_more_input_options(*cmd, o->more);
     cmd->add_option("--size", o->size,
                     "Sensor size WxH; events outside it are errors [default: the file's own "
                     "size, else 240x180, the DAVIS240C of the Event-Camera Dataset]")

@@ -32,7 +32,7 @@ CsvReader::CsvReader(InputFile file, ReaderOptions options)
     : lines_(std::move(file)), options_(std::move(options)) {
     sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
     const std::string& u = options_.csv_time_unit;
-    if (u == "us") time_digits_ = 0;
+    if (u == "us" || u.empty()) time_digits_ = 0;
     else if (u == "ms") time_digits_ = 3;
     else if (u == "s") time_digits_ = 6;
     else if (u == "ns") time_div_ = 1000;
