@@ -61,9 +61,10 @@ bool looks_like_atis(std::string_view name, std::string_view head, std::optional
     if (n == 0) return size && *size == 0;
     const auto* p = reinterpret_cast<const unsigned char*>(head.data());
     std::uint32_t prev = raw_time(p);
+    int wraps = 0;
     for (std::size_t i = 1; i < n; ++i) {
         const std::uint32_t t = raw_time(p + i * kRecord);
-        if (t < prev && prev - t <= kHalf) return false;
+        if (t < prev && (prev - t <= kHalf || ++wraps > 1)) return false;
         prev = t;
     }
     return true;

@@ -8,13 +8,12 @@
 
 namespace evcorner::io {
 
-namespace {
-
-// The offending line, shortened and with unprintable bytes escaped.
-std::string quote(const char* b, const char* e) {
+std::string quote_bytes(std::string_view text, std::size_t max) {
+    const char* b = text.data();
+    const char* e = b + text.size();
     std::string s;
-    const bool cut = e - b > 80;
-    if (cut) e = b + 80;
+    const bool cut = text.size() > max;
+    if (cut) e = b + max;
     for (const char* p = b; p < e; ++p) {
         const auto c = static_cast<unsigned char>(*p);
         if (c >= 0x20 && c < 0x7f)
@@ -25,6 +24,8 @@ std::string quote(const char* b, const char* e) {
     return "'" + s + (cut ? "...'" : "'");
 }
 
+namespace {
+std::string quote(const char* b, const char* e) { return quote_bytes(std::string_view(b, static_cast<std::size_t>(e - b))); }
 }  // namespace
 
 void LineSource::fail(const char* begin, const char* end, const std::string& reason) const {

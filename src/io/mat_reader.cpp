@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/line_source.hpp"
 
 namespace evcorner::io {
 
@@ -47,7 +48,7 @@ std::string describe(const matvar_t* v) {
                                              "double", "single", "int8",   "uint8",  "int16",  "uint16",
                                              "int32",  "uint32", "int64",  "uint64", "function", "opaque"};
     const auto c = static_cast<std::size_t>(v->class_type);
-    return fmt::format("'{}' ({} {}{})", v->name ? v->name : "?", dims, c < std::size(kClass) ? kClass[c] : "?",
+    return fmt::format("{} ({} {}{})", quote_bytes(v->name ? v->name : "?", 64), dims, c < std::size(kClass) ? kClass[c] : "?",
                        v->isComplex ? ", complex" : "");
 }
 
@@ -87,7 +88,7 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
     MatPtr mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
     if (!mat)
         throw InputError(name_, "libmatio cannot open it as a MAT-file" +
-                                    (g_matio_message.empty() ? std::string() : ": " + g_matio_message));
+                                    (g_matio_message.empty() ? std::string() : ": libmatio says " + quote_bytes(g_matio_message, 200)));
 
     // Columns.
     const std::string spec = options_.mat_columns.empty() ? "x,y,p,t" : options_.mat_columns;
@@ -141,8 +142,8 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
     }
     VarPtr var(Mat_VarRead(mat.get(), var_.c_str()));
     if (!var)
-        throw InputError(name_, "no variable '" + var_ + "' can be read" +
-                                    (g_matio_message.empty() ? std::string() : " (libmatio: " + g_matio_message + ")"));
+        throw InputError(name_, "no variable " + quote_bytes(var_) + " can be read" +
+                                    (g_matio_message.empty() ? std::string() : " (libmatio says " + quote_bytes(g_matio_message, 200) + ")"));
     if (!is_event_matrix(var.get()) || var->data == nullptr)
         throw InputError(name_, "variable " + describe(var.get()) + " is not an N x 4 real numeric matrix");
     rows_ = var->dims[0];
@@ -182,7 +183,7 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
         });
         rows_ = std::min<std::uint64_t>(rows_, bad);  // rows up to the bad one are read, then the error
         if (bad < rows) error_ = std::make_exception_ptr(InputError(
-                            name_, fmt::format("variable '{}', row {}: time does not fit 63 bits", var_, bad + 1)));
+                            name_, fmt::format("variable {}, row {}: time does not fit 63 bits", quote_bytes(var_, 64), bad + 1)));
     }
     sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
     if (sensor_) {
@@ -200,7 +201,7 @@ std::uint64_t MatReader::bytes_consumed() const noexcept {
 }
 
 void MatReader::fail_row(std::uint64_t row, const std::string& reason) const {
-    throw InputError(name_, fmt::format("variable '{}', row {}: {}", var_, row + 1, reason));
+    throw InputError(name_, fmt::format("variable {}, row {}: {}", quote_bytes(var_, 64), row + 1, reason));
 }
 
 std::size_t MatReader::read(std::span<Event> out) {

@@ -16,6 +16,7 @@
 #include "evcorner/io/evt2_reader.hpp"
 #include "evcorner/io/evt3_reader.hpp"
 #include "evcorner/io/hdf5_events.hpp"
+#include "evcorner/io/line_source.hpp"
 #include "evcorner/io/mat_reader.hpp"
 #include "evcorner/io/npy.hpp"
 #include "evcorner/io/prophesee_header.hpp"
@@ -169,7 +170,7 @@ std::string detect_format(InputFile& file) {
                 if (starts_with(why, file.name() + ": ")) why.erase(0, file.name().size() + 2);
                 constexpr std::string_view kLooks = "unsupported format: this looks like ";
                 if (starts_with(why, "byte ")) why.insert(0, "compressed ");  // the decompressor's own
-                else if (starts_with(why, kLooks)) why.insert(kLooks.size(), std::string(codec) + "-compressed ");
+                else if (starts_with(why, kLooks)) why.insert(kLooks.size(), std::string(codec) + "-compressed data holding ");
                 else why = "in the " + std::string(codec) + "-compressed data: " + why;
                 throw InputError(file.name(), why);
             }
@@ -213,7 +214,7 @@ std::string detect_format(InputFile& file) {
         if (h.evt == "2.0") return "evt2";
         if (!h.evt.empty())
             throw InputError(file.name(),
-                             "Prophesee RAW encoding EVT " + h.evt + " is not supported (EVT 2.0 and 3.0 are)");
+                             "Prophesee RAW encoding EVT " + quote_bytes(h.evt) + " is not supported (EVT 2.0 and 3.0 are)");
         if (whole && !p.done)
             throw InputError(file.name(), InputError::Unit::byte, head.size(),
                              "the file ends inside its '%' header, before a line naming the encoding "

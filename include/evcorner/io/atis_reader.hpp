@@ -13,7 +13,8 @@
 //
 // Detection: the format has no magic. open_event_reader() takes a file as ATIS when its
 // name ends in ".bin", its size (when known) is a multiple of 5, and the first records
-// (up to 4096) have time never going back (wraps allowed): looks_like_atis(). `--format
+// (up to 4096) have time never going back, but for at most one wrap of the 23-bit
+// counter (8.4 s apart: more in 4096 events is noise, not a recording): looks_like_atis(). `--format
 // atis-bin` reads any input as ATIS.
 
 #include <cstdint>

@@ -11,12 +11,17 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "evcorner/io/input_file.hpp"
 
 namespace evcorner::io {
+
+/// `s` in single quotes for a message: at most `max` bytes ("..." after a cut), every
+/// byte outside printable ASCII written as \xNN, so that no raw byte reaches a terminal.
+std::string quote_bytes(std::string_view s, std::size_t max = 80);
 
 class LineSource {
 public:
