@@ -92,7 +92,8 @@ const std::array<Magic, 24> kMagics = {{
                                       "; evcorner reads " + std::string(kInputFormats));
 }
 
-// Whether `head` can be the start of a text file: no NUL byte, and few control bytes.
+// Whether `head` can be the start of a text file: no NUL byte, and few other control
+// bytes (a stray escape sequence in a text file is the text parser's to report, escaped).
 bool looks_like_text(std::string_view head) {
     std::size_t control = 0;
     for (const char ch : head) {
@@ -100,7 +101,7 @@ bool looks_like_text(std::string_view head) {
         if (c == 0) return false;
         if (c < 0x20 && c != '\n' && c != '\r' && c != '\t' && c != '\f' && c != '\v') ++control;
     }
-    return control * 100 <= head.size();  // at most 1 %
+    return control < 4 || control * 16 <= head.size();
 }
 
 // Peeks at growing amounts until `enough` says the head decides the format, the input
