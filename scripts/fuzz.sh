@@ -13,7 +13,7 @@ shared="$root/../shared/data/real"
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DEVCORNER_FUZZ=ON -DEVCORNER_BUILD_APPS=OFF -DEVCORNER_BUILD_TESTS=OFF -DEVCORNER_BUILD_BENCH=OFF >/dev/null
-targets=(text csv aedat2 evt2 evt3 dat aedat4 hdf5 npy)
+targets=(text csv aedat2 evt2 evt3 dat aedat4 hdf5 npy atis mat compressed)
 cmake --build "$build" -j "${FUZZ_JOBS:-2}" --target "${targets[@]/#/fuzz_}" >/dev/null
 
 # Seeds: the first 64 KiB of each matching file (inputs are capped at that length).
@@ -36,6 +36,10 @@ seed aedat2 "$shared"/davis240c-imu-pyaedattools/*.aedat "$shared"/dvs128-walkin
 seed evt2 "$shared"/expelliarmus/evt2_sample.raw "$shared"/faery-testdata/evt2.raw
 seed evt3 "$shared"/expelliarmus/evt3_sample.raw
 seed dat "$shared"/tonic-testdata/sample_ncars.dat
+seed npy fuzz/seeds/seed-*.npy
+seed atis "$shared"/tonic-testdata/sample_nmnist.bin "$shared"/evlib-shiba/faces_easy_0001.bin
+seed mat fuzz/seeds/*.mat "$shared"/rpg-event-lifetime/*.mat
+seed compressed fuzz/seeds/seed.txt.* fuzz/seeds/seed.csv.* fuzz/seeds/seed.csv fuzz/seeds/seed.npy
 
 mkdir -p "$build/artifacts" "$build/logs"
 failed=()

@@ -154,7 +154,8 @@ bool first_data_line(std::string_view head, bool& comma) {
 
 std::string detect_format(InputFile& file) {
     constexpr std::size_t kLongest = 16;  // covers every signature
-    const std::string_view start = file.peek(kLongest);
+    // (A later peek() may move the bytes: `start` is taken again after each.)
+    std::string_view start = file.peek(kLongest);
     for (const Signature& s : kSignatures)
         if (starts_with(start, s.magic)) return std::string(s.format);
     if (!file.compression()) {
@@ -181,6 +182,16 @@ std::string detect_format(InputFile& file) {
             return inner;
         }
     }
+    start = file.peek(kLongest);
+    if (start.size() < kLongest && start.size() >= 2) {
+        // The whole input is a few bytes that begin a signature: a file cut short.
+        std::string what;
+        for (const Signature& s : kSignatures)
+            if (starts_with(s.magic, start)) what += (what.empty() ? "" : " or ") + std::string(s.what);
+        if (!what.empty())
+            throw InputError(file.name(), InputError::Unit::byte, start.size(),
+                             fmt::format("the file ends inside the {} signature: it is cut short", what));
+    }
     {
         const std::string_view head = file.peek(512);
         for (const Magic& m : kMagics) {
@@ -196,15 +207,7 @@ std::string detect_format(InputFile& file) {
             looks_like_atis(n, file.peek(5 * 4096), file.size()))
             return "atis-bin";
     }
-    if (start.size() < kLongest && start.size() >= 2) {
-        // The whole input is a few bytes that begin a signature: a file cut short.
-        std::string what;
-        for (const Signature& s : kSignatures)
-            if (starts_with(s.magic, start)) what += (what.empty() ? "" : " or ") + std::string(s.what);
-        if (!what.empty())
-            throw InputError(file.name(), InputError::Unit::byte, start.size(),
-                             fmt::format("the file ends inside the {} signature: it is cut short", what));
-    }
+    start = file.peek(kLongest);
     if (starts_with(start, "%")) {
         // Prophesee: the '%' header names the encoding (RAW) or says "Data file" (DAT).
         const auto [head, whole] = head_until(file, [](std::string_view h) { return parse_percent_header(h).done; });
