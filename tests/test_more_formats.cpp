@@ -240,6 +240,25 @@ TEST_F(MoreFormatsCli, CompressedTextThroughInfoAndStandardInput) {
     EXPECT_EQ(b["format"], "ecd-text+zstd");
     for (const char* k : {"events", "t_first_us", "t_last_us", "x_min", "x_max", "y_min", "y_max", "on"})
         EXPECT_EQ(a[k], b[k]) << k;
+    // convert: the compressed copy gives the plain file's events.
+    write("cut.csv.gz", gzip_bytes(text));  // ECD text inside, whatever the name says
+    ASSERT_EQ(run("convert -q cut.csv.gz back.txt").status, 0);
+    EXPECT_EQ(read_path((dir_ / "back.txt").string()), read_path((dir_ / "cut.txt").string()));
+}
+
+TEST_F(MoreFormatsCli, AtisFromStandardInputWithFormat) {
+    EVCORNER_REQUIRE_SHARED_DATA();
+    const std::string nmnist = real("tonic-testdata/sample_nmnist.bin");
+    const CliResult r = run("info --no-progress --format atis-bin --json a.json -", nmnist);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "a.json"));
+    EXPECT_EQ(j["events"], 4325);
+    EXPECT_EQ(j["t_last_us"], 311175);
+    // Without --format a pipe has no name to tell ATIS by: refused, naming the option.
+    const CliResult n = run("info --no-progress -", nmnist);
+    EXPECT_EQ(n.status, 1);
+    EXPECT_NE(n.err.find("unsupported format"), std::string::npos) << n.err;
+    EXPECT_NE(n.err.find("--format atis-bin"), std::string::npos) << n.err;
 }
 
 // ---------------------------------------------------------------- BOM
@@ -366,7 +385,7 @@ TEST(NpyGeneral, PlainNBy4ArraysWithColumnNames) {
     TempDir tmp;
     std::string tx, xy;  // t,x,y,p (the default) and x,y,p,t orders
     for (const Event& e : kNpyEvents) {
-        for (double v : {static_cast<double>(e.t) * 1e-6, double{e.x}, double{e.y}, double{e.p}}) put<double>(tx, v);
+        for (double v : {static_cast<double>(e.t) * 1e-6, static_cast<double>(e.x), static_cast<double>(e.y), static_cast<double>(e.p)}) put<double>(tx, v);
         for (std::int64_t v : {std::int64_t{e.x}, std::int64_t{e.y}, std::int64_t{e.p}, e.t}) put<std::int64_t>(xy, v);
     }
     io::ReaderOptions o;

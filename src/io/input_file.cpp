@@ -51,7 +51,8 @@ InputFile::InputFile(InputFile&& other) noexcept
       raw_pos_(other.raw_pos_),
       raw_fill_(other.raw_fill_),
       raw_used_(other.raw_used_),
-      stream_ended_(other.stream_ended_) {}
+      stream_ended_(other.stream_ended_),
+      decoded_end_(other.decoded_end_) {}
 
 InputFile::~InputFile() {
     if (owns_fd_) ::close(fd_);
@@ -77,7 +78,7 @@ std::string_view InputFile::peek(std::size_t n) {
         ahead_.erase(0, ahead_pos_);
         ahead_pos_ = 0;
     }
-    while (ahead_.size() < n && !eof_) {
+    while (ahead_.size() < n && !(decoder_ ? decoded_end_ : eof_)) {
         // Ask for a little more than needed from a file (fewer calls); a pipe returns
         // what it holds without waiting for the rest.
         const std::size_t want = std::max<std::size_t>(n - ahead_.size(), 4096);
@@ -134,7 +135,10 @@ std::size_t InputFile::read_decoded(char* buf, std::size_t n) {
             raw_fill_ = read_fd(raw_.data(), raw_.size());
         }
         if (raw_pos_ == raw_fill_ && eof_) {
-            if (stream_ended_) return 0;
+            if (stream_ended_) {
+                decoded_end_ = true;
+                return 0;
+            }
             throw InputError(name_, InputError::Unit::byte, raw_used_,
                              std::string("the ") + std::string(codec) +
                                  " stream is cut short: the compressed file ends before the stream does");

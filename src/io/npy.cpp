@@ -392,7 +392,7 @@ NpyReader::NpyReader(InputFile file, ReaderOptions options)
         fast_ = (itemsize_ == 16 || itemsize_ == 13) && int_time && is(0, 'i', 8, 0) && is(1, 'u', 2, 8) &&
                 is(2, 'u', 2, 10) && (is(3, 'u', 1, 12) || is(3, 'b', 1, 12)) &&
                 (itemsize_ == 13 || descr->items.size() == 4 || descr->items.size() == 5);
-        if (itemsize_ == 0) fail(pre, "the structured dtype has no bytes");
+        if (itemsize_ > 4096) fail(pre, fmt::format("records of {} bytes: larger than 4096 bytes are not read", itemsize_));
     } else {
         fail(pre, "unsupported dtype: 'descr' is neither a type string nor a list of fields");
     }

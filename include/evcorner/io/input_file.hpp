@@ -74,6 +74,7 @@ private:
     std::size_t raw_pos_ = 0, raw_fill_ = 0;
     std::uint64_t raw_used_ = 0;  // compressed bytes given to the decoder
     bool stream_ended_ = false;   // the decoder reported the end of a stream
+    bool decoded_end_ = false;    // every stream decoded and the file ended
 };
 
 }  // namespace evcorner::io
