@@ -43,7 +43,10 @@ bool is_event_matrix(const matvar_t* v) {
 
 std::string describe(const matvar_t* v) {
     std::string dims;
-    for (int i = 0; i < v->rank; ++i) dims += (i ? "x" : "") + std::to_string(v->dims[i]);
+    for (int i = 0; i < v->rank; ++i) {
+        if (i > 0) dims += 'x';
+        dims += std::to_string(v->dims[i]);
+    }
     static constexpr const char* kClass[] = {"empty",  "cell",   "struct", "object", "char",   "sparse",
                                              "double", "single", "int8",   "uint8",  "int16",  "uint16",
                                              "int32",  "uint32", "int64",  "uint64", "function", "opaque"};
@@ -98,10 +101,11 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
         int col = 0;
         for (;; ++col) {
             const auto comma = spec.find(',', start);
-            std::string n = spec.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-            n.erase(0, n.find_first_not_of(' '));
-            n.erase(n.find_last_not_of(' ') + 1);
-            for (char& ch : n) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+            std::string_view field = std::string_view(spec).substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+            while (!field.empty() && field.front() == ' ') field.remove_prefix(1);
+            while (!field.empty() && field.back() == ' ') field.remove_suffix(1);
+            std::string n;
+            for (const char ch : field) n += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
             int role = -1;
             if (n == "t" || n == "ts" || n == "timestamp" || n == "time" || n == "t_us") role = 0;
             else if (n == "x") role = 1;

@@ -82,11 +82,11 @@ struct Py {
     std::string s;
     std::uint64_t n = 0;
     bool b = false;
-    std::vector<Py> items;                          // seq
-    std::vector<std::pair<std::string, Py>> pairs;  // dict
+    std::vector<Py> items;         // seq; dict: the values
+    std::vector<std::string> keys;  // dict: the keys of items
     const Py* get(std::string_view key) const {
-        for (const auto& [k, v] : pairs)
-            if (k == key) return &v;
+        for (std::size_t i = 0; i < keys.size(); ++i)
+            if (keys[i] == key) return &items[i];
         return nullptr;
     }
 };
@@ -158,7 +158,8 @@ private:
                     ++i_;
                     auto val = value(depth + 1);
                     if (!val) return std::nullopt;
-                    v.pairs.emplace_back(item->s, std::move(*val));
+                    v.keys.push_back(item->s);
+                    v.items.push_back(std::move(*val));
                 } else {
                     v.items.push_back(std::move(*item));
                 }
