@@ -500,7 +500,7 @@ bool NpyReader::decode_general() {
                         mark(i, 0, fmt::format("time {} is not a finite number in range", v));
                         break;
                     }
-                    out[i] = std::llrint(v);
+                    out[i] = static_cast<std::int64_t>(v + (v >= 0 ? 0.5 : -0.5));  // nearest, halves away from zero
                 }
             } else {
                 const std::int64_t mul = time_mul_, div = time_div_;
@@ -537,7 +537,8 @@ bool NpyReader::decode_general() {
             for (std::size_t i = 0; i < records; ++i) {
                 const T v = load<T>(q + i * stride, f.swap);
                 bool ok;
-                if constexpr (std::is_floating_point_v<T>) ok = v >= 0 && v <= 65535 && v == std::floor(v);
+                // (A cast and back, not std::floor: floor is a library call without SSE4.1.)
+                if constexpr (std::is_floating_point_v<T>) ok = v >= 0 && v <= 65535 && static_cast<T>(static_cast<std::uint32_t>(v)) == v;
                 else if constexpr (std::is_signed_v<T>) ok = v >= 0 && static_cast<std::int64_t>(v) <= 65535;
                 else ok = static_cast<std::uint64_t>(v) <= 65535;
                 if (!ok) [[unlikely]] {

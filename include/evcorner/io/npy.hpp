@@ -14,7 +14,8 @@
 // - a two-dimensional (N, 4) array of one such numeric type, its columns named by
 //   ReaderOptions::npy_columns (default "t,x,y,p", the written layout's order).
 // Time: integers are microseconds, floats seconds, unless ReaderOptions::csv_time_unit
-// names the unit ("us", "ns", "ms", "s"); floats are rounded to the nearest microsecond.
+// names the unit ("us", "ns", "ms", "s"); floats are rounded to the nearest microsecond
+// (halves away from zero).
 // x and y must be integers 0..65535 (a float one must be integral); polarity 1 = ON,
 // 0 or -1 = OFF (or bool). The evcorner layout (and its packed 13-byte form, 'p' as bool)
 // is read by a copying fast path; every other layout converts each field column-wise.
