@@ -512,8 +512,8 @@ struct MatVar {
     std::size_t rows, cols;
     bool int32 = false;
 };
-std::string write_mat(const std::string& path, const std::vector<MatVar>& vars) {
-    mat_t* m = Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5);
+std::string write_mat(const std::string& path, const std::vector<MatVar>& vars, mat_ft version = MAT_FT_MAT5) {
+    mat_t* m = Mat_CreateVer(path.c_str(), nullptr, version);
     EXPECT_NE(m, nullptr);
     for (const MatVar& v : vars) {
         std::size_t dims[2] = {v.rows, v.cols};
@@ -576,6 +576,12 @@ TEST(Mat, VariableAndColumnsByOption) {
     EXPECT_NE(res.error.find("row 1"), std::string::npos) << res.error;
     o.csv_time_unit = "s";
     EXPECT_EQ(read_path(sec, o), kNpyEvents);
+    // MAT 7.3 (HDF5 inside, a text header first): told as .mat, not HDF5.
+    const std::string v73 = write_mat(tmp.path("v73.mat"), {{"events", columns({1, 2, 3, 0}), 4, 4}}, MAT_FT_MAT73);
+    io::ReaderOptions plain;
+    plain.fallback_sensor = std::nullopt;
+    EXPECT_EQ(io::detect_format(v73), "mat");
+    EXPECT_EQ(read_path(v73, plain), kNpyEvents);
     // No N x 4 variable at all.
     const std::string none = write_mat(tmp.path("none.mat"), {{"m", {1, 2, 3, 4, 5, 6}, 2, 3}});
     try {

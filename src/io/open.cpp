@@ -236,7 +236,7 @@ std::string detect_format(InputFile& file) {
         const std::string_view n = file.name();
         if (n.size() >= 4 && (n.substr(n.size() - 4) == ".bin" || n.substr(n.size() - 4) == ".BIN"))
             hint = "a .bin file whose first records are not ATIS events in time order; --format atis-bin reads it anyway";
-        else
+        else if (!file.compression())
             hint = "ATIS .bin data (N-MNIST, N-Caltech101) has no signature: --format atis-bin reads it";
         unsupported(file, "binary data of no known kind (not text, no known signature)", hint);
     }
