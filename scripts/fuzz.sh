@@ -13,7 +13,7 @@ shared="$root/../shared/data/real"
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DEVCORNER_FUZZ=ON -DEVCORNER_BUILD_APPS=OFF -DEVCORNER_BUILD_TESTS=OFF -DEVCORNER_BUILD_BENCH=OFF >/dev/null
-targets=(text csv aedat2 evt2 evt3 dat aedat4 hdf5 npy)
+targets=(text csv aedat2 evt2 evt3 dat aedat4 hdf5 npy atis mat compressed)
 targets+=(mcap rosbag rosbag2)  # ROS bags, read in memory
 cmake --build "$build" -j "${FUZZ_JOBS:-2}" --target "${targets[@]/#/fuzz_}" >/dev/null
 
@@ -40,6 +40,10 @@ seed dat "$shared"/tonic-testdata/sample_ncars.dat
 seed mcap fuzz/seeds/*.mcap "$shared"/ros2-event-camera-py/test_events_2/*.mcap
 seed rosbag fuzz/seeds/seed.bag "$shared"/ros2-event-camera-py/ros1/*.bag
 seed rosbag2 fuzz/seeds/seed.db3
+seed npy fuzz/seeds/seed-*.npy
+seed atis "$shared"/tonic-testdata/sample_nmnist.bin "$shared"/evlib-shiba/faces_easy_0001.bin
+seed mat fuzz/seeds/*.mat "$shared"/rpg-event-lifetime/*.mat
+seed compressed fuzz/seeds/seed.txt.* fuzz/seeds/seed.csv.* fuzz/seeds/seed.csv fuzz/seeds/seed.npy
 
 mkdir -p "$build/artifacts" "$build/logs"
 failed=()

@@ -10,7 +10,7 @@ packages=(
   zlib1g-dev libpng-dev
   liblz4-dev libzstd-dev libhdf5-dev hdf5-filter-plugin hdf5-filter-plugin-blosc-serial
   clang libclang-rt-14-dev
-  libsqlite3-dev libbz2-dev
+  libsqlite3-dev libbz2-dev liblzma-dev libmatio-dev
 )
 
 missing=()

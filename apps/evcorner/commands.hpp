@@ -4,6 +4,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "evcorner/io/event_reader.hpp"
+
 namespace evcorner::cli {
 
 void add_detect_command(CLI::App& app);
@@ -19,6 +21,18 @@ void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_colu
                        std::string& chip);
 /// --topic: the topic of a ROS bag to read (ReaderOptions::topic).
 void add_topic_option(CLI::App& cmd, std::string& topic);
+/// The options of the formats added with issue 16 (.npy columns, MATLAB variable and
+/// columns), kept together so that each command adds and applies them in one line each.
+struct MoreInputOptions {
+    std::string npy_columns, mat_var, mat_columns;
+    void apply(io::ReaderOptions& r) const {
+        r.npy_columns = npy_columns;
+        r.mat_var = mat_var;
+        r.mat_columns = mat_columns;
+    }
+};
+/// --npy-columns, --mat-var, --mat-columns.
+void add_more_input_options(CLI::App& cmd, MoreInputOptions& o);
 /// --to: the output format (detect, convert); an unknown name is a usage error.
 void add_output_format_option(CLI::App& cmd, std::string& to);
 

@@ -30,9 +30,10 @@ struct ConvertOptions {
     std::string to = "auto";
     std::string size;
     std::string csv_columns;
-    std::string time_unit = "us";
+    std::string time_unit;
     std::string chip;
     std::string topic;
+    MoreInputOptions more;
     bool skip_invalid = false;
     bool allow_damaged = false;
     bool quiet = false;
@@ -65,6 +66,7 @@ void run_convert(const ConvertOptions& o) {
     ropts.csv_time_unit = o.time_unit;
     ropts.aedat2_chip = o.chip;
     ropts.topic = o.topic;
+    o.more.apply(ropts);
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
     // The input's size (--size included) goes into formats that record one.
     const std::optional<SensorSize> sensor = reader->sensor();
@@ -141,6 +143,7 @@ void add_convert_command(CLI::App& app) {
     cmd->add_option("OUTPUT", o->output, "Output file (- = standard output, text formats)")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
     add_topic_option(*cmd, o->topic);
+    add_more_input_options(*cmd, o->more);
     add_output_format_option(*cmd, o->to);
     cmd->add_option("--size", o->size,
                     "Sensor size WxH to check events against (overrides the file's) and to record")

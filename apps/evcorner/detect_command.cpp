@@ -31,9 +31,10 @@ struct DetectOptions {
     pipeline::DetectFiles files;
     pipeline::DetectOptions run;
     std::string csv_columns;
-    std::string time_unit = "us";
+    std::string time_unit;
     std::string chip;
     std::string topic;
+    MoreInputOptions more;
     std::string size;
     std::string summary_json;
     bool skip_invalid = false;
@@ -112,6 +113,7 @@ void run_detect(DetectOptions& o) {
     ropts.aedat2_chip = o.chip;
     ropts.topic = o.topic;
     o.run.param_prefix = "--";
+    o.more.apply(ropts);
 
     // The bar is drawn only on a terminal; the last update also tells how far a run that
     // stops at an input error got.
@@ -172,6 +174,7 @@ void add_detect_command(CLI::App& app) {
     add_output_format_option(*cmd, o->files.to);
     add_input_options(*cmd, o->files.format, o->csv_columns, o->time_unit, o->chip);
     add_topic_option(*cmd, o->topic);
+    add_more_input_options(*cmd, o->more);
     cmd->add_option("--size", o->size,
                     "Sensor size WxH; events outside it are errors [default: the file's own "
                     "size, else 240x180, the DAVIS240C of the Event-Camera Dataset]")

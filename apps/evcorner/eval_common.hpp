@@ -13,16 +13,18 @@
 #include "evcorner/event.hpp"
 #include "evcorner/io/event_reader.hpp"
 #include "evcorner/sensor.hpp"
+#include "commands.hpp"
 
 namespace evcorner::cli {
 
 struct InputOptions {
     std::string format = "auto";
     std::string csv_columns;
-    std::string time_unit = "us";
+    std::string time_unit;
     std::string size;  ///< WxH, empty: the file's own, else 240x180
     std::string chip;  ///< AEDAT 2.0 camera, empty: the header's "# AEChip"
     std::string topic;  ///< ROS bag topic, empty: the bag's one event topic
+    MoreInputOptions more;
 };
 
 struct LoadedEvents {

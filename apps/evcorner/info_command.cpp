@@ -33,9 +33,10 @@ struct InfoOptions {
     std::string format = "auto";
     std::string size;
     std::string csv_columns;
-    std::string time_unit = "us";
+    std::string time_unit;
     std::string chip;
     std::string topic;
+    MoreInputOptions more;
     std::string json;
     bool skip_invalid = false;
     bool no_progress = false;
@@ -114,6 +115,7 @@ void run_info(const InfoOptions& o) {
     ropts.csv_time_unit = o.time_unit;
     ropts.aedat2_chip = o.chip;
     ropts.topic = o.topic;
+    o.more.apply(ropts);
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
     // With the JSON on standard output, the table goes to standard error.
     std::FILE* human = o.json == "-" ? stderr : stdout;
@@ -209,8 +211,8 @@ void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_colu
         });
     cmd.add_option("--csv-columns", csv_columns,
                    "CSV column order, e.g. x,y,p,t ('_' skips a column) [default: the header row, else t,x,y,p]");
-    cmd.add_option("--time-unit", time_unit, "CSV time unit: us, ns, ms or s")
-        ->capture_default_str()
+    cmd.add_option("--time-unit", time_unit,
+                   "Time unit: us, ns, ms or s [default: CSV and .mat us; .npy integers us, floats s]")
         ->check(CLI::IsMember({"us", "ns", "ms", "s"}));
     cmd.add_option("--chip", chip,
                    "AEDAT 2.0: the camera that recorded the file (DVS128, DAVIS240C, DAVIS346, ...), "
@@ -228,6 +230,16 @@ void add_topic_option(CLI::App& cmd, std::string& topic) {
                    "[default: the bag's one event topic]");
 }
 
+void add_more_input_options(CLI::App& cmd, MoreInputOptions& o) {
+    cmd.add_option("--npy-columns", o.npy_columns,
+                   ".npy: the meaning of a plain (N, 4) array's columns, e.g. x,y,p,t ('_' skips one) "
+                   "[default: t,x,y,p]");
+    cmd.add_option("--mat-var", o.mat_var,
+                   "MATLAB .mat: the variable holding the N x 4 events [default: the only N x 4 numeric one]");
+    cmd.add_option("--mat-columns", o.mat_columns,
+                   "MATLAB .mat: the meaning of the variable's 4 columns ('_' skips one) [default: x,y,p,t]");
+}
+
 void add_info_command(CLI::App& app) {
     auto o = std::make_shared<InfoOptions>();
     CLI::App* cmd = app.add_subcommand(
@@ -242,6 +254,7 @@ void add_info_command(CLI::App& app) {
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
     add_topic_option(*cmd, o->topic);
+    add_more_input_options(*cmd, o->more);
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";

@@ -1,4 +1,5 @@
 #include "evcorner/io/aedat2_reader.hpp"
+#include "evcorner/io/line_source.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -132,7 +133,7 @@ void Aedat2Reader::check_layout() {
             if ((a & 0x400u) == 0) off += ((a >> 12) & 0x3FF) >= w || ((a >> 22) & 0x1FF) >= h;
         }
     }
-    const std::string chip = chip_.empty() ? std::string("none") : "'" + chip_ + "'";
+    const std::string chip = chip_.empty() ? std::string("none") : quote_bytes(chip_);
     if (off * 2 > words)
         fail(offset(), fmt::format("{} of the first {} address words decode outside the {}x{} sensor of the "
                                    "header's AEChip {}: that line does not name the camera that recorded the "

@@ -30,9 +30,11 @@ std::string lower_trim(std::string_view s) {
 
 CsvReader::CsvReader(InputFile file, ReaderOptions options)
     : lines_(std::move(file)), options_(std::move(options)) {
+    format_ = "csv";
+    if (const auto c = lines_.file().compression()) format_ += "+" + std::string(compression_name(*c));
     sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
     const std::string& u = options_.csv_time_unit;
-    if (u == "us") time_digits_ = 0;
+    if (u == "us" || u.empty()) time_digits_ = 0;
     else if (u == "ms") time_digits_ = 3;
     else if (u == "s") time_digits_ = 6;
     else if (u == "ns") time_div_ = 1000;
@@ -53,16 +55,16 @@ void CsvReader::set_columns(const std::string& spec, bool from_header) {
         else if (name == "y") f = kY;
         else if (name == "p" || name == "pol" || name == "polarity") f = kP;
         else if (!from_header && name != "_")
-            throw InputError(lines_.file().name(), "unknown CSV column '" + name + "' in '" + spec +
-                                               "' (t, x, y, p, or _ to ignore one)");
+            throw InputError(lines_.file().name(), "unknown CSV column " + quote_bytes(name) + " in " + quote_bytes(spec) +
+                                               " (t, x, y, p, or _ to ignore one)");
         if (f != kIgnore && seen[f]++ > 0)
-            throw InputError(lines_.file().name(), "CSV column '" + name + "' named twice in '" + spec + "'");
+            throw InputError(lines_.file().name(), "CSV column " + quote_bytes(name) + " named twice in " + quote_bytes(spec));
         cols.push_back(f);
         if (comma == std::string::npos) break;
         start = comma + 1;
     }
     if (std::count(seen.begin(), seen.end(), 1) != 4) {
-        const std::string why = "CSV columns '" + spec + "' do not name each of t, x, y and p";
+        const std::string why = "CSV columns " + quote_bytes(spec) + " do not name each of t, x, y and p";
         if (from_header) throw InputError(lines_.file().name(), InputError::Unit::line, lines_.line(), why);
         throw InputError(lines_.file().name(), why);
     }

@@ -144,7 +144,8 @@ Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
     impl_->file = Hid(quiet([&] { return H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT); }), H5Fclose);
     if (!impl_->file.ok()) throw InputError(name_, "HDF5 cannot open the file (damaged?): " + hdf5_reason(errno));
     const hid_t f = impl_->file.get();
-    if (!link_exists(f, "events")) throw InputError(name_, "no 'events' group: not a DSEC or event_utils HDF5 file");
+    if (!link_exists(f, "events")) throw InputError(name_, "unsupported format: this looks like an HDF5 file without events (no 'events' group: "
+                                              "not a DSEC or event_utils layout)");
     static const char* dsec[4] = {"events/x", "events/y", "events/t", "events/p"};
     static const char* eu[4] = {"events/xs", "events/ys", "events/ts", "events/ps"};
     if (link_exists(f, dsec[2]))

@@ -11,11 +11,14 @@
 #include "evcorner/error.hpp"
 #include "evcorner/io/aedat2_reader.hpp"
 #include "evcorner/io/aedat4_reader.hpp"
+#include "evcorner/io/atis_reader.hpp"
 #include "evcorner/io/csv_reader.hpp"
 #include "evcorner/io/dat_reader.hpp"
 #include "evcorner/io/evt2_reader.hpp"
 #include "evcorner/io/evt3_reader.hpp"
 #include "evcorner/io/hdf5_events.hpp"
+#include "evcorner/io/line_source.hpp"
+#include "evcorner/io/mat_reader.hpp"
 #include "evcorner/io/npy.hpp"
 #include "evcorner/io/prophesee_header.hpp"
 #include "evcorner/io/ros_bag.hpp"
@@ -41,6 +44,63 @@ constexpr std::array<Signature, 4> kSignatures = {{
 }};
 
 bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+
+// Files told by their first bytes beyond the formats above: a reader's format name, or
+// an empty format for a kind evcorner cannot read ("unsupported format: this looks like
+// WHAT", with the hint). Checked in order; `offset` is where the magic stands.
+// (ROS: wt-ros fills in the format names of the bag readers.)
+struct Magic {
+    std::size_t offset;
+    std::string_view magic;
+    std::string_view format;  // empty: no reader
+    std::string_view what;
+    std::string_view hint;
+};
+constexpr std::string_view kAny = "";
+const std::array<Magic, 24> kMagics = {{
+    {0, "MATLAB 5.0 MAT-file", "mat", "a MATLAB 5.0 MAT-file", kAny},
+    {0, "MATLAB 7.3 MAT-file", "mat", "a MATLAB 7.3 MAT-file", kAny},
+    {0, "#ROSBAG", "", "a ROS bag of an unknown version", kAny},
+    {0, "#!AER-DAT3", "", "an AEDAT 3.x file", "AEDAT 2.0 and 4.0 are read; convert it with the DV software"},
+    {0, "#!AER-DAT", "", "an AEDAT file of an unknown version", "AEDAT 2.0 and 4.0 are read"},
+    {0, "Event Stream", "", "an Event Stream (.es) file", kAny},
+    {0, std::string_view("PK\x03\x04", 4), "", "a zip archive (a .npz?)",
+     "unzip it and pass the .npy or text file inside"},
+    {0, std::string_view("PK\x05\x06", 4), "", "an empty zip archive", kAny},
+    {0, std::string_view("\x89PNG\r\n\x1a\n", 8), "", "a PNG image", kAny},
+    {0, std::string_view("\xff\xd8\xff", 3), "", "a JPEG image", kAny},
+    {0, "GIF8", "", "a GIF image", kAny},
+    {0, std::string_view("II*\0", 4), "", "a TIFF image", kAny},
+    {0, std::string_view("MM\0*", 4), "", "a TIFF image", kAny},
+    {0, "%PDF-", "", "a PDF document", kAny},
+    {0, std::string_view("\x7f" "ELF", 4), "", "an ELF executable or library", kAny},
+    {0, std::string_view("7z\xbc\xaf\x27\x1c", 6), "", "a 7-Zip archive", kAny},
+    {0, std::string_view("Rar!\x1a\x07", 6), "", "a RAR archive", kAny},
+    {0, std::string_view("\x04\x22\x4d\x18", 4), "", "an LZ4 frame (compressed data)",
+     "decompress it first (lz4 -d); gzip, zstd, bzip2 and xz are read directly"},
+    {0, "PAR1", "", "an Apache Parquet file", kAny},
+    {257, "ustar", "", "a tar archive", "extract it and pass the event file inside"},
+    {4, "ftyp", "", "an MP4/MOV video", kAny},
+}};
+
+// Thrown for a file no reader takes: what it looks like, never its raw bytes.
+[[noreturn]] void unsupported(const InputFile& file, std::string_view what, std::string_view hint) {
+    throw InputError(file.name(), "unsupported format: this looks like " + std::string(what) +
+                                      (hint.empty() ? std::string() : " (" + std::string(hint) + ")") +
+                                      "; evcorner reads " + std::string(kInputFormats));
+}
+
+// Whether `head` can be the start of a text file: no NUL byte, and few other control
+// bytes (a stray escape sequence in a text file is the text parser's to report, escaped).
+bool looks_like_text(std::string_view head) {
+    std::size_t control = 0;
+    for (const char ch : head) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c == 0) return false;
+        if (c < 0x20 && c != '\n' && c != '\r' && c != '\t' && c != '\f' && c != '\v') ++control;
+    }
+    return control < 4 || control * 16 <= head.size();
+}
 
 // Peeks at growing amounts until `enough` says the head decides the format, the input
 // ends, or kMaxHead bytes were seen. Returns the head and whether it is the whole input.
@@ -92,10 +152,36 @@ bool first_data_line(std::string_view head, bool& comma) {
 
 std::string detect_format(InputFile& file) {
     constexpr std::size_t kLongest = 16;  // covers every signature
-    const std::string_view start = file.peek(kLongest);
+    // (A later peek() may move the bytes: `start` is taken again after each.)
+    std::string_view start = file.peek(kLongest);
     if (const std::string_view bag = detect_bag_format(start); !bag.empty()) return std::string(bag);
     for (const Signature& s : kSignatures)
         if (starts_with(start, s.magic)) return std::string(s.format);
+    if (!file.compression()) {
+        if (const auto c = compression_from_magic(start)) {
+            // Compressed: text and CSV inside are read through the decompressor.
+            file.decompress(*c);
+            const std::string_view codec = compression_name(*c);
+            std::string inner;
+            try {
+                inner = detect_format(file);
+            } catch (const InputError& e) {
+                // Say that the message is about the data inside the compressed file.
+                std::string why = e.what();
+                if (starts_with(why, file.name() + ": ")) why.erase(0, file.name().size() + 2);
+                constexpr std::string_view kLooks = "unsupported format: this looks like ";
+                if (starts_with(why, "byte ")) why.insert(0, "compressed ");  // the decompressor's own
+                else if (starts_with(why, kLooks)) why.insert(kLooks.size(), std::string(codec) + "-compressed data holding ");
+                else why = "in the " + std::string(codec) + "-compressed data: " + why;
+                throw InputError(file.name(), why);
+            }
+            if (inner != "ecd-text" && inner != "csv")
+                unsupported(file, fmt::format("{}-compressed {} data", codec, inner),
+                            fmt::format("only text and CSV are read compressed; decompress it first"));
+            return inner;
+        }
+    }
+    start = file.peek(kLongest);
     if (start.size() < kLongest && start.size() >= 2) {
         // The whole input is a few bytes that begin a signature: a file cut short.
         std::string what;
@@ -105,6 +191,22 @@ std::string detect_format(InputFile& file) {
             throw InputError(file.name(), InputError::Unit::byte, start.size(),
                              fmt::format("the file ends inside the {} signature: it is cut short", what));
     }
+    {
+        const std::string_view head = file.peek(512);
+        for (const Magic& m : kMagics) {
+            if (head.size() < m.offset + m.magic.size() || head.substr(m.offset, m.magic.size()) != m.magic) continue;
+            if (m.format.empty()) unsupported(file, m.what, m.hint);
+            return std::string(m.format);
+        }
+        if (starts_with(head, "\xff\xfe") || starts_with(head, "\xfe\xff"))
+            unsupported(file, "UTF-16 text", "save it as UTF-8 or ASCII");
+        // ATIS .bin has no magic: the name's extension, then the records' plausibility.
+        const std::string_view n = file.name();
+        if (!file.compression() && n.size() >= 4 && (n.substr(n.size() - 4) == ".bin" || n.substr(n.size() - 4) == ".BIN") &&
+            looks_like_atis(n, file.peek(5 * 4096), file.size()))
+            return "atis-bin";
+    }
+    start = file.peek(kLongest);
     if (starts_with(start, "%")) {
         // Prophesee: the '%' header names the encoding (RAW) or says "Data file" (DAT).
         const auto [head, whole] = head_until(file, [](std::string_view h) { return parse_percent_header(h).done; });
@@ -115,7 +217,7 @@ std::string detect_format(InputFile& file) {
         if (h.evt == "2.0") return "evt2";
         if (!h.evt.empty())
             throw InputError(file.name(),
-                             "Prophesee RAW encoding EVT " + h.evt + " is not supported (EVT 2.0 and 3.0 are)");
+                             "Prophesee RAW encoding EVT " + quote_bytes(h.evt) + " is not supported (EVT 2.0 and 3.0 are)");
         if (whole && !p.done)
             throw InputError(file.name(), InputError::Unit::byte, head.size(),
                              "the file ends inside its '%' header, before a line naming the encoding "
@@ -124,7 +226,20 @@ std::string detect_format(InputFile& file) {
     }
     // Text: CSV when the first line that is not a comment has a comma.
     bool comma = false;
-    const auto [head, whole] = head_until(file, [&](std::string_view h) { return first_data_line(h, comma); });
+    auto [head, whole] = head_until(file, [&](std::string_view h) {
+        if (starts_with(h, "\xEF\xBB\xBF")) h.remove_prefix(3);  // a UTF-8 BOM
+        return first_data_line(h, comma);
+    });
+    if (!looks_like_text(head.substr(0, 4096))) {
+        std::string hint;
+        const std::string_view n = file.name();
+        if (n.size() >= 4 && (n.substr(n.size() - 4) == ".bin" || n.substr(n.size() - 4) == ".BIN"))
+            hint = "a .bin file whose first records are not ATIS events in time order; --format atis-bin reads it anyway";
+        else if (!file.compression())
+            hint = "ATIS .bin data (N-MNIST, N-Caltech101) has no signature: --format atis-bin reads it";
+        unsupported(file, "binary data of no known kind (not text, no known signature)", hint);
+    }
+    if (starts_with(head, "\xEF\xBB\xBF")) head.remove_prefix(3);
     first_data_line(head, comma);
     return comma ? "csv" : "ecd-text";
 }
@@ -141,8 +256,9 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
     InputFile file(path);
     std::string fmt_name(format);
     if (fmt_name == "auto") fmt_name = detect_format(file);
-    constexpr std::array<std::string_view, 12> kNames = {"ecd-text", "text", "csv", "npy",  "aedat2", "aedat",
-                                                         "aedat4",   "evt2", "evt3", "dat", "hdf5",   "h5"};
+    constexpr std::array<std::string_view, 14> kNames = {"ecd-text", "text", "csv", "npy",  "aedat2", "aedat",
+                                                         "aedat4",   "evt2", "evt3", "dat", "hdf5",   "h5",
+                                                         "atis-bin", "mat"};
     if (std::find(kNames.begin(), kNames.end(), fmt_name) == kNames.end() && !is_bag_format(fmt_name))
         throw InputError(file.name(), "unknown input format '" + fmt_name + "' (known: " + std::string(kInputFormats) + ")");
     if (!options.aedat2_chip.empty() && fmt_name != "aedat2" && fmt_name != "aedat")
@@ -153,6 +269,10 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
                                     fmt_name);
     // Bags are read by seeking: the reader opens the path itself.
     if (is_bag_format(fmt_name)) return open_bag_reader(path, std::move(options), fmt_name);
+    if ((fmt_name == "ecd-text" || fmt_name == "text" || fmt_name == "csv") && !file.compression())
+        if (const auto c = compression_from_magic(file.peek(8))) file.decompress(*c);  // a forced format
+    if (fmt_name == "atis-bin") return std::make_unique<AtisReader>(std::move(file), std::move(options));
+    if (fmt_name == "mat") return std::make_unique<MatReader>(path, std::move(options));
     if (fmt_name == "ecd-text" || fmt_name == "text") {
         if (!options.sensor) options.sensor = options.fallback_sensor;
         return std::make_unique<TextReader>(std::move(file), std::move(options));

@@ -85,7 +85,10 @@ Parsed parse_line(const char* p, const char* end) {
 }  // namespace
 
 TextReader::TextReader(InputFile file, ReaderOptions options)
-    : lines_(std::move(file)), options_(std::move(options)) {}
+    : lines_(std::move(file)), options_(std::move(options)) {
+    format_ = "ecd-text";
+    if (const auto c = lines_.file().compression()) format_ += "+" + std::string(compression_name(*c));
+}
 
 std::size_t TextReader::read(std::span<Event> out) {
     skips_.new_batch();

@@ -30,7 +30,8 @@ public:
     [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
     [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
-    [[nodiscard]] std::string_view format() const noexcept override { return "csv"; }
+    /// "csv", or "csv+gzip" (zstd, bzip2, xz) for a compressed file.
+    [[nodiscard]] std::string_view format() const noexcept override { return format_; }
     [[nodiscard]] const std::string& name() const noexcept override { return lines_.file().name(); }
     [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return lines_.file().consumed(); }
     [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return lines_.file().size(); }
@@ -41,6 +42,7 @@ private:
     bool parse(const char* b, const char* e, Event& ev, const char*& why) const;
 
     LineSource lines_;
+    std::string format_;
     ReaderOptions options_;
     std::optional<SensorSize> sensor_;
     std::vector<Field> columns_;

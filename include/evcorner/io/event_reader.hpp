@@ -37,8 +37,17 @@ struct ReaderOptions {
     /// "DAVIS240C", "DAVIS346", ...; see aedat2_reader.hpp), used instead of the header's
     /// "# AEChip:" line for the address layout and the sensor size. Empty: the header's.
     std::string aedat2_chip;
-    /// CSV only: the unit of the t column: "us" (integers), "ns", "ms" or "s" (decimals).
-    std::string csv_time_unit = "us";
+    /// The unit of the time values: CSV's t column ("us" (integers), "ns", "ms" or "s"
+    /// (decimals)), and .npy / .mat time fields. Empty: the format's default (CSV: us;
+    /// .npy and .mat: integers us, floats s).
+    std::string csv_time_unit;
+    /// .npy only: the meaning of the 4 columns of a plain (N, 4) array, e.g. "x,y,p,t"
+    /// ("_" ignores one). Empty: "t,x,y,p".
+    std::string npy_columns;
+    /// MATLAB .mat only: the variable holding the N x 4 events (empty: the only N x 4
+    /// numeric one), and the meaning of its columns (empty: "x,y,p,t").
+    std::string mat_var;
+    std::string mat_columns;
     /// ROS bags only: the topic to read (ros_bag.hpp). Empty: the bag's one event topic.
     std::string topic;
 };

@@ -6,10 +6,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include "evcorner/io/decompress.hpp"
 
 namespace evcorner::io {
 
@@ -36,11 +40,24 @@ public:
     /// Size in bytes when the input is a regular file (nullopt: a pipe, a terminal, a
     /// device; such an input can only be read front to back).
     [[nodiscard]] std::optional<std::uint64_t> size() const noexcept { return size_; }
-    /// Bytes handed out by read() so far (bytes only peeked at do not count).
-    [[nodiscard]] std::uint64_t consumed() const noexcept { return consumed_; }
+    /// Bytes handed out by read() so far (bytes only peeked at do not count); once
+    /// decompress() was called, the compressed bytes decoded so far (progress against size()).
+    [[nodiscard]] std::uint64_t consumed() const noexcept { return decoder_ ? raw_used_ : consumed_; }
+
+    /// From the first unread byte on, the input is a stream compressed with `c` (several
+    /// concatenated streams too): peek() and read() hand out the decompressed bytes. A
+    /// damaged stream, one cut short, or other data after its end throws InputError naming
+    /// the compressed byte offset ("the gzip stream is cut short ..."). Call once.
+    void decompress(Compression c);
+    /// The compression decompress() was given, if any.
+    [[nodiscard]] std::optional<Compression> compression() const noexcept {
+        return decoder_ ? std::optional<Compression>(decoder_->kind()) : std::nullopt;
+    }
 
 private:
     std::size_t read_fd(char* buf, std::size_t n);
+    std::size_t read_source(char* buf, std::size_t n);  // read_fd, or through the decoder
+    std::size_t read_decoded(char* buf, std::size_t n);
 
     std::string name_;
     int fd_ = -1;
@@ -50,6 +67,14 @@ private:
     std::string ahead_;           // bytes peeked at and not yet read
     std::size_t ahead_pos_ = 0;   // the first unread byte of ahead_
     bool eof_ = false;            // the descriptor reported the end
+
+    // Decompression (decompress()): compressed bytes wait in raw_[raw_pos_, raw_fill_).
+    std::unique_ptr<Decompressor> decoder_;
+    std::vector<char> raw_;
+    std::size_t raw_pos_ = 0, raw_fill_ = 0;
+    std::uint64_t raw_used_ = 0;  // compressed bytes given to the decoder
+    bool stream_ended_ = false;   // the decoder reported the end of a stream
+    bool decoded_end_ = false;    // every stream decoded and the file ended
 };
 
 }  // namespace evcorner::io

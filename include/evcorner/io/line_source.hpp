@@ -2,18 +2,26 @@
 // The lines of a text file (or standard input), read in large blocks with constant
 // memory: what the text-format readers (ECD text, CSV) share. A line is handed out
 // without its line break and without a '\r' before it; the last line needs no break.
-// Errors name the file and the 1-based line, quoting the offending text.
+// Errors name the file and the 1-based line, quoting the offending text (unprintable bytes
+// escaped). A UTF-8 byte order mark (EF BB BF) at the start of the input is skipped. The
+// file may be decompressing (InputFile::decompress): a damaged or cut-short stream is an
+// error at the line being read, naming the compressed byte offset.
 
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "evcorner/io/input_file.hpp"
 
 namespace evcorner::io {
+
+/// `s` in single quotes for a message: at most `max` bytes ("..." after a cut), every
+/// byte outside printable ASCII written as \xNN, so that no raw byte reaches a terminal.
+std::string quote_bytes(std::string_view s, std::size_t max = 80);
 
 class LineSource {
 public:
@@ -47,12 +55,14 @@ public:
 
 private:
     bool next_after_refill(const char*& begin, const char*& end);
+    void skip_bom();
 
     InputFile file_;
     std::vector<char> buf_;
     std::size_t pos_ = 0;   // start of the unread data in buf_
     std::size_t fill_ = 0;  // bytes valid in buf_
     bool eof_ = false;
+    bool bom_checked_ = false;
     std::uint64_t line_ = 0;
 };
 

@@ -1,14 +1,29 @@
 #pragma once
-// numpy .npy files of events (format version 1.0): a one-dimensional array of the
-// structured dtype
+// numpy .npy files of events (format versions 1.0, 2.0, 3.0).
+//
+// Written: a one-dimensional array of the structured dtype
 //   [('t','<i8'), ('x','<u2'), ('y','<u2'), ('p','u1'), ('_','V3')]
 // which is evcorner::Event byte for byte (16 bytes, 3 padding bytes written as zero),
-// so numpy.load() gives t in microseconds, x, y, p directly. The reader also takes the
-// packed 13-byte form without the padding field, and 'p' stored as '|b1' (bool).
+// so numpy.load() gives t in microseconds, x, y, p directly.
+//
+// Read (C order only; Fortran order is refused):
+// - a one-dimensional structured array whose fields are found by name, in any order and
+//   among other fields: time 't', 'ts', 'timestamp', 'time' or 't_us'; 'x'; 'y'; polarity
+//   'p', 'polarity', 'pol' or 'on' (names compared case-insensitively). Each of them any
+//   integer ('i1'..'i8', 'u1'..'u8'), float ('f4', 'f8') or bool ('b1') of either byte order;
+// - a two-dimensional (N, 4) array of one such numeric type, its columns named by
+//   ReaderOptions::npy_columns (default "t,x,y,p", the written layout's order).
+// Time: integers are microseconds, floats seconds, unless ReaderOptions::csv_time_unit
+// names the unit ("us", "ns", "ms", "s"); floats are rounded to the nearest microsecond
+// (halves away from zero).
+// x and y must be integers 0..65535 (a float one must be integral); polarity 1 = ON,
+// 0 or -1 = OFF (or bool). The evcorner layout (and its packed 13-byte form, 'p' as bool)
+// is read by a copying fast path; every other layout converts each field column-wise.
 
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "evcorner/io/binary_reader.hpp"
 #include "evcorner/io/event_writer.hpp"
@@ -45,11 +60,28 @@ public:
     /// The array length the header declares.
     [[nodiscard]] std::uint64_t declared_events() const noexcept { return declared_; }
 
+    /// One field of a record: where it is and its numpy type.
+    struct Field {
+        std::size_t offset = 0;
+        char kind = 'i';  // 'i' signed, 'u' unsigned, 'f' float, 'b' bool
+        int size = 8;
+        bool swap = false;  // big-endian ('>')
+    };
+
 private:
     bool decode() override;
+    bool decode_fast();
+    bool decode_general();
     std::uint64_t declared_ = 0;
     std::uint64_t read_ = 0;
     std::size_t itemsize_ = 16;
+    bool fast_ = true;
+    Field fields_[4];         // t, x, y, p
+    double time_scale_ = 1;   // float time * scale = us
+    std::int64_t time_mul_ = 1, time_div_ = 1;  // integer time * mul / div = us
+    // Column-wise conversion buffers of decode_general().
+    std::vector<std::int64_t> ct_;
+    std::vector<std::uint32_t> cx_, cy_, cp_;
 };
 
 }  // namespace evcorner::io

@@ -14,7 +14,7 @@
 namespace evcorner::io {
 
 /// The format names open_event_reader() accepts, besides "auto".
-inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat, hdf5, rosbag2, mcap, rosbag";
+inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat, hdf5, atis-bin, mat, rosbag2, mcap, rosbag";
 
 /// Tells the format of `file` from its first bytes, which it only peeks at
 /// (InputFile::peek), so a reader given `file` afterwards reads them too: "aedat2"

@@ -40,7 +40,8 @@ public:
     [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
     [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return options_.sensor; }
-    [[nodiscard]] std::string_view format() const noexcept override { return "ecd-text"; }
+    /// "ecd-text", or "ecd-text+gzip" (zstd, bzip2, xz) for a compressed file.
+    [[nodiscard]] std::string_view format() const noexcept override { return format_; }
     [[nodiscard]] const std::string& name() const noexcept override { return lines_.file().name(); }
     [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return lines_.file().consumed(); }
     [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return lines_.file().size(); }
@@ -50,6 +51,7 @@ public:
 
 private:
     LineSource lines_;
+    std::string format_;
     ReaderOptions options_;
     std::uint64_t events_ = 0;
     std::int64_t last_t_ = INT64_MIN;
