@@ -14,6 +14,8 @@
 #include "evcorner/naive/coverage_naive.hpp"
 #include "evcorner/sim/coverage.hpp"
 #include "evcorner/sim/geometry.hpp"
+#include "evcorner/sim/motion.hpp"
+#include "evcorner/sim/texture.hpp"
 #include "evcorner/sim/presets.hpp"
 #include "evcorner/sim/random.hpp"
 #include "evcorner/sim/scene.hpp"
@@ -235,6 +237,40 @@ TEST(SimulateStreaming, StepsComeInTimeOrderAndRespectTheRefractoryPeriod) {
         }
         prev[{e.x, e.y}] = e.t;
     }
+}
+
+// The image the simulator keeps (recomputed only near moving edges) against a full render
+// at the same time: background, then every object composited with polygon_coverage().
+TEST(SimulateStreaming, ImageNearEdgesOnlyEqualsAFullRender) {
+    const Scene s = parse_scene(busy(4), "busy");
+    Simulator sim(s);
+    std::vector<Event> sink;
+    int checked = 0;
+    for (int k = 0; sim.step(sink); ++k) {
+        if (k % 37 != 0) continue;
+        std::vector<double> img = background_image(s.background, s.sensor, s.seed);
+        const double t_s = sim.time_us() / 1e6;
+        for (const Object& o : s.objects) {
+            const Pose pose(o.motion, t_s, s.duration_s);
+            std::vector<double> b(img.size(), 0.0), sum(img.size(), 0.0);
+            for (const Piece& p : o.pieces) {
+                std::vector<Vec2> poly;
+                for (const Vec2& v : p.polygon) poly.push_back(pose.apply(v));
+                const std::vector<double> c = polygon_coverage(poly, s.sensor);
+                for (std::size_t i = 0; i < c.size(); ++i) {
+                    b[i] += c[i];
+                    sum[i] += c[i] * p.intensity;
+                }
+            }
+            for (std::size_t i = 0; i < img.size(); ++i) img[i] = img[i] * (1 - b[i]) + sum[i];
+        }
+        const auto got = sim.image();
+        double worst = 0;
+        for (std::size_t i = 0; i < img.size(); ++i) worst = std::max(worst, std::abs(got[i] - img[i]));
+        EXPECT_LT(worst, 1e-9) << "at " << sim.time_us() << " us";
+        ++checked;
+    }
+    EXPECT_GT(checked, 10);
 }
 
 // Random simple polygons, convex or not: star-shaped around a centre.

@@ -8,8 +8,9 @@ namespace evcorner::sim {
 namespace {
 
 // One edge from (x0, y0) to (x1, y1), y0 < y1; h for a row is sign * its y-extent there.
+template <bool Record>
 void accumulate_edge(double x0, double y0, double x1, double y1, double sign, double* acc, std::size_t stride, int width,
-                     int height) noexcept {
+                     int height, std::vector<std::vector<int>>* touched) noexcept {
     const double dxdy = (x1 - x0) / (y1 - y0);
     const int r0 = std::max(0, static_cast<int>(std::floor(y0)));
     const int r1 = std::min(height - 1, static_cast<int>(std::ceil(y1)) - 1);
@@ -19,10 +20,12 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
         if (yb <= ya) continue;
         const double h = sign * (yb - ya);
         double* row = acc + static_cast<std::size_t>(r) * stride;
+        [[maybe_unused]] std::vector<int>* cols = Record ? &(*touched)[static_cast<std::size_t>(r)] : nullptr;
         const double xa = x0 + (ya - y0) * dxdy, xb = x0 + (yb - y0) * dxdy;
         const double xl = std::min(xa, xb), xr = std::max(xa, xb);
         if (xr <= 0) {  // wholly left of the sensor: covers every pixel of the row to its right
             row[0] += h;
+            if constexpr (Record) cols->push_back(0);
             continue;
         }
         if (xl >= width) continue;
@@ -30,12 +33,17 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
             const int k = static_cast<int>(std::floor(xl));
             row[k] += h * (k + 1 - xl);
             row[k + 1] += h * (xl - k);
+            if constexpr (Record) {
+                cols->push_back(k);
+                cols->push_back(k + 1);
+            }
             continue;
         }
         const double per_x = h / (xr - xl);
         double lo = xl;
         if (lo < 0) {
             row[0] += per_x * (0 - lo);
+            if constexpr (Record) cols->push_back(0);
             lo = 0;
         }
         const double hi_end = std::min(xr, static_cast<double>(width));
@@ -46,9 +54,28 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
             const double xm = 0.5 * (lo + hi);
             row[k] += hp * (k + 1 - xm);
             row[k + 1] += hp * (xm - k);
+            if constexpr (Record) {
+                cols->push_back(k);
+                cols->push_back(k + 1);
+            }
             lo = hi;
             ++k;
         }
+    }
+}
+
+template <bool Record>
+void accumulate(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width, int height,
+                std::vector<std::vector<int>>* touched) noexcept {
+    const std::size_t n = poly.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec2 a = poly[i], b = poly[(i + 1) % n];
+        if (a.y == b.y) continue;  // horizontal edges bound no area to their right
+        // Upward edges (b.y < a.y) add, downward ones subtract: a positive-area polygon covers +1.
+        if (a.y < b.y)
+            accumulate_edge<Record>(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height, touched);
+        else
+            accumulate_edge<Record>(b.x, b.y, a.x, a.y, weight, acc, stride, width, height, touched);
     }
 }
 
@@ -56,16 +83,12 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
 
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
                         int height) noexcept {
-    const std::size_t n = poly.size();
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec2 a = poly[i], b = poly[(i + 1) % n];
-        if (a.y == b.y) continue;  // horizontal edges bound no area to their right
-        // Upward edges (b.y < a.y) add, downward ones subtract: a positive-area polygon covers +1.
-        if (a.y < b.y)
-            accumulate_edge(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height);
-        else
-            accumulate_edge(b.x, b.y, a.x, a.y, weight, acc, stride, width, height);
-    }
+    accumulate<false>(poly, weight, acc, stride, width, height, nullptr);
+}
+
+void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
+                        int height, std::vector<std::vector<int>>& touched) {
+    accumulate<true>(poly, weight, acc, stride, width, height, &touched);
 }
 
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size) {

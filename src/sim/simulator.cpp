@@ -15,6 +15,8 @@ namespace {
 // Coverage within this of 0 or 1 is 0 or 1: the running sums of a pixel inside a polygon
 // give 1 - 1e-16 now and then, and a steady pixel must not change.
 constexpr double kSnap = 1e-12;
+// Largest move of any vertex in one step, px (mark_edges needs less than 1).
+constexpr double kMaxMove = 0.75;
 constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
 }  // namespace
 
@@ -40,6 +42,8 @@ Simulator::Simulator(Scene scene)
     // The image at t = 0, every row dirty.
     place_objects(0.0);
     prev_rects_ = rects_;
+    prev_polys_ = polys_;
+    touched_.resize(static_cast<std::size_t>(h_));
     moving_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
         const Motion& m = scene_.objects[o].motion;
@@ -116,20 +120,50 @@ void Simulator::place_objects(double t_us) {
     }
 }
 
+void Simulator::mark_edges(const std::vector<std::vector<Vec2>>& pieces) {
+    // Every cell an edge touches, widened by one pixel on each side and one row up and down:
+    // with edges moving less than a pixel per step (step()), every pixel whose coverage
+    // changes touches an edge before or after the step.
+    for (const auto& poly : pieces) {
+        const std::size_t n = poly.size();
+        for (std::size_t i = 0; i < n; ++i) {
+            Vec2 a = poly[i], b = poly[(i + 1) % n];
+            if (a.y > b.y) std::swap(a, b);
+            const int r0 = std::max(0, static_cast<int>(std::floor(a.y)) - 1);
+            const int r1 = std::min(h_ - 1, static_cast<int>(std::floor(b.y)) + 1);
+            const double dxdy = b.y > a.y ? (b.x - a.x) / (b.y - a.y) : 0.0;
+            for (int r = r0; r <= r1; ++r) {
+                double xa, xb;
+                if (b.y > a.y) {
+                    const double ya = std::clamp(static_cast<double>(r - 1), a.y, b.y);
+                    const double yb = std::clamp(static_cast<double>(r + 2), a.y, b.y);
+                    xa = a.x + (ya - a.y) * dxdy;
+                    xb = a.x + (yb - a.y) * dxdy;
+                } else {
+                    xa = a.x;
+                    xb = b.x;
+                }
+                const double lo_x = std::min(xa, xb), hi_x = std::max(xa, xb);
+                if (hi_x < -1 || lo_x >= w_ + 1) continue;
+                const int lo = std::max(0, static_cast<int>(std::floor(std::max(lo_x, -2.0))) - 1);
+                const int hi = std::min(w_ - 1, static_cast<int>(std::floor(std::min(hi_x, w_ + 1.0))) + 1);
+                if (lo <= hi) spans_[static_cast<std::size_t>(r)].push_back({lo, hi});
+            }
+        }
+    }
+}
+
 double Simulator::render(bool all_rows) {
     for (auto& row : spans_) row.clear();
     if (all_rows) {
         for (auto& row : spans_) row.push_back({0, w_ - 1});
     } else {
-        // The dirty columns of each row: wherever a moving object was or is, as sorted,
-        // disjoint spans.
         for (std::size_t o = 0; o < rects_.size(); ++o) {
             if (!moving_[o]) continue;
-            for (const Rect& r : {prev_rects_[o], rects_[o]}) {
-                if (r.empty()) continue;
-                for (int y = r.y0; y <= r.y1; ++y) spans_[static_cast<std::size_t>(y)].push_back({r.x0, r.x1});
-            }
+            mark_edges(prev_polys_[o]);
+            mark_edges(polys_[o]);
         }
+        // Sorted, disjoint spans per row.
         for (auto& row : spans_) {
             if (row.size() < 2) continue;
             std::sort(row.begin(), row.end());
@@ -152,7 +186,9 @@ double Simulator::render(bool all_rows) {
                       next_.begin() + static_cast<std::ptrdiff_t>(base + static_cast<std::size_t>(lo)));
     }
     // Each object over what lies behind it: I = I (1 - b) + sum_k b_k I_k, b = sum_k b_k, its
-    // pieces' coverages (they never overlap, so b is the object's own coverage).
+    // pieces' coverages (they never overlap, so b is the object's own coverage). The running
+    // sum of a row changes only at the columns the edges touched, so it is walked from one
+    // touched column to the next, and evaluated only at the dirty pixels.
     for (std::size_t o = 0; o < rects_.size(); ++o) {
         const Rect& r = rects_[o];
         if (r.empty()) continue;
@@ -163,37 +199,37 @@ double Simulator::render(bool all_rows) {
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
         for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-            accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_);
+            accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_, touched_);
             if (multi) accumulate_polygon(polys_[o][k], obj.pieces[k].intensity, acc_int_.data(), stride_, w_, h_);
         }
         const double level = obj.pieces[0].intensity;
-        const int xend = std::min(r.x1 + 1, w_);
         for (int y = r.y0; y <= r.y1; ++y) {
+            auto& cols = touched_[static_cast<std::size_t>(y)];
+            if (cols.empty()) continue;
+            std::sort(cols.begin(), cols.end());
+            cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
             double* ac = &acc_cov_[static_cast<std::size_t>(y) * stride_];
             double* ai = &acc_int_[static_cast<std::size_t>(y) * stride_];
             double* out = &next_[static_cast<std::size_t>(y) * w];
-            // The running sums over the object's columns; composited where the row is dirty.
-            const auto& row_spans = spans_[static_cast<std::size_t>(y)];
-            std::size_t si = 0;
-            int lo = row_spans.empty() ? INT_MAX : row_spans[0].first;
-            int hi = row_spans.empty() ? INT_MAX : row_spans[0].second;
+            std::size_t ci = 0;
             double b = 0, s = 0;
-            for (int x = r.x0; x <= xend; ++x) {
-                b += ac[x];
-                ac[x] = 0;
-                if (multi) {
-                    s += ai[x];
-                    ai[x] = 0;
+            for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)]) {
+                for (int x = lo; x <= hi; ++x) {
+                    while (ci < cols.size() && cols[ci] <= x) {
+                        const int c = cols[ci++];
+                        b += ac[c];
+                        if (multi) s += ai[c];
+                    }
+                    if (b <= kSnap) continue;
+                    const double bc = b >= 1.0 - kSnap ? 1.0 : b;
+                    out[x] = out[x] * (1.0 - bc) + (multi ? s : bc * level);
                 }
-                while (x > hi) {
-                    ++si;
-                    lo = si < row_spans.size() ? row_spans[si].first : INT_MAX;
-                    hi = si < row_spans.size() ? row_spans[si].second : INT_MAX;
-                }
-                if (x < lo || x > r.x1 || b <= kSnap) continue;
-                const double bc = b >= 1.0 - kSnap ? 1.0 : b;
-                out[x] = out[x] * (1.0 - bc) + (multi ? s : bc * level);
             }
+            for (const int c : cols) {
+                ac[c] = 0;
+                ai[c] = 0;
+            }
+            cols.clear();
         }
     }
     if (all_rows) return 0;
@@ -202,11 +238,24 @@ double Simulator::render(bool all_rows) {
     for (int y = 0; y < h_; ++y) {
         const std::size_t base = static_cast<std::size_t>(y) * w;
         for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)])
-        for (int x = lo; x <= hi; ++x) {
-            const double a = cur_[base + static_cast<std::size_t>(x)], b = next_[base + static_cast<std::size_t>(x)];
-            if (a == b) continue;
-            worst = std::max(worst, std::abs(a - b) / (kLogEps + std::min(a, b)));
-        }
+            for (int x = lo; x <= hi; ++x) {
+                const double a = cur_[base + static_cast<std::size_t>(x)], b = next_[base + static_cast<std::size_t>(x)];
+                if (a == b) continue;
+                worst = std::max(worst, std::abs(a - b) / (kLogEps + std::min(a, b)));
+            }
+    }
+    return worst;
+}
+
+double Simulator::max_displacement() const noexcept {
+    double worst = 0;
+    for (std::size_t o = 0; o < polys_.size(); ++o) {
+        if (!moving_[o]) continue;
+        for (std::size_t k = 0; k < polys_[o].size(); ++k)
+            for (std::size_t v = 0; v < polys_[o][k].size(); ++v) {
+                const Vec2 a = polys_[o][k][v], b = prev_polys_[o][k][v];
+                worst = std::max(worst, std::max(std::abs(a.x - b.x), std::abs(a.y - b.y)));
+            }
     }
     return worst;
 }
@@ -281,8 +330,16 @@ bool Simulator::step(std::vector<Event>& out) {
     for (;;) {
         const double t1 = std::min(end_, t_ + dt);
         place_objects(t1);
-        const double change = render(false);
         const double taken = t1 - t_;
+        // Edges move less than a pixel per step, so that the pixels near them are all that
+        // can change (mark_edges).
+        const double moved = max_displacement();
+        if (moved > kMaxMove && taken > sp.min_step_us) {
+            ++stats_.rejected_steps;
+            dt = std::max(sp.min_step_us, taken * 0.9 * kMaxMove / moved);
+            continue;
+        }
+        const double change = render(false);
         if (change > limit && taken > sp.min_step_us) {
             ++stats_.rejected_steps;
             dt = std::max(sp.min_step_us, taken * std::max(0.1, 0.9 * limit / change));
@@ -300,9 +357,11 @@ bool Simulator::step(std::vector<Event>& out) {
         for (const Event& e : step_events_) ++(e.p ? stats_.on : stats_.off);
         out.insert(out.end(), step_events_.begin(), step_events_.end());
         prev_rects_ = rects_;
+        prev_polys_ = polys_;
         ++stats_.steps;
         stats_.max_step_change = std::max(stats_.max_step_change, change / scene_.camera.contrast);
         dt_ = std::min(sp.max_step_us, change > 0 ? taken * std::clamp(0.9 * limit / change, 0.5, 2.0) : 2.0 * taken);
+        if (moved > 0) dt_ = std::min(dt_, taken * 0.9 * kMaxMove / moved * 2.0);
         dt_ = std::max(dt_, sp.min_step_us);
         t_ = t1;
         return true;

@@ -25,6 +25,11 @@ namespace evcorner::sim {
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
                         int height) noexcept;
 
+/// The same, also appending to touched[r] every column k of row r whose acc entry it changes
+/// (the running sum of a row changes only at those columns).
+void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
+                        int height, std::vector<std::vector<int>>& touched);
+
 /// The coverage of every pixel (row-major, width x height), each in [0, 1].
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size);
 

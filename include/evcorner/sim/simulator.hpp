@@ -20,8 +20,10 @@
 //               t = 0); events sorted by (t, y, x, p) within a step, steps in time order
 //
 // Streaming: step() hands out one step's events at a time; memory is a few arrays the size
-// of the sensor, whatever the duration. Only the pixels inside the bounding boxes of moving
-// objects (before and after the step) are recomputed; the rest cannot change.
+// of the sensor, whatever the duration. Steps are also short enough that no vertex moves
+// 0.75 px; then only the pixels within a pixel of a moving edge (before or after the step)
+// can change, and only they are recomputed: the work per step follows the edges' length,
+// not the objects' area.
 
 #include <cstdint>
 #include <span>
@@ -68,6 +70,8 @@ private:
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
     double render(bool all_rows);     // renders into next_ over the dirty rows; returns max |dL| bound
+    void mark_edges(const std::vector<std::vector<Vec2>>& pieces);
+    [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
     void emit_noise(double t1, std::vector<Event>& step_events);
 
@@ -84,7 +88,8 @@ private:
     std::vector<double> acc_cov_, acc_int_;
     // Per object: its pieces' polygons at the time being rendered, and the pixel rectangles
     // it covers then (rects_) and at time_us() (prev_rects_).
-    std::vector<std::vector<std::vector<Vec2>>> polys_;
+    std::vector<std::vector<std::vector<Vec2>>> polys_, prev_polys_;
+    std::vector<std::vector<int>> touched_;  // per row: the columns whose accumulator entries are set
     std::vector<Rect> rects_, prev_rects_;
     std::vector<char> moving_;
     std::vector<std::vector<std::pair<int, int>>> spans_;  // each row's dirty columns, inclusive, sorted, disjoint
