@@ -43,7 +43,6 @@ Simulator::Simulator(Scene scene)
     place_objects(0.0);
     prev_rects_ = rects_;
     prev_polys_ = polys_;
-    touched_.resize(static_cast<std::size_t>(h_));
     moving_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
         const Motion& m = scene_.objects[o].motion;
@@ -186,9 +185,8 @@ double Simulator::render(bool all_rows) {
                       next_.begin() + static_cast<std::ptrdiff_t>(base + static_cast<std::size_t>(lo)));
     }
     // Each object over what lies behind it: I = I (1 - b) + sum_k b_k I_k, b = sum_k b_k, its
-    // pieces' coverages (they never overlap, so b is the object's own coverage). The running
-    // sum of a row changes only at the columns the edges touched, so it is walked from one
-    // touched column to the next, and evaluated only at the dirty pixels.
+    // pieces' coverages (they never overlap, so b is the object's own coverage), evaluated only
+    // at the dirty pixels.
     for (std::size_t o = 0; o < rects_.size(); ++o) {
         const Rect& r = rects_[o];
         if (r.empty()) continue;
@@ -199,37 +197,47 @@ double Simulator::render(bool all_rows) {
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
         for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-            accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_, touched_);
+            accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_);
             if (multi) accumulate_polygon(polys_[o][k], obj.pieces[k].intensity, acc_int_.data(), stride_, w_, h_);
         }
         const double level = obj.pieces[0].intensity;
+        const int xend = std::min(r.x1 + 1, w_);
         for (int y = r.y0; y <= r.y1; ++y) {
-            auto& cols = touched_[static_cast<std::size_t>(y)];
-            if (cols.empty()) continue;
-            std::sort(cols.begin(), cols.end());
-            cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
             double* ac = &acc_cov_[static_cast<std::size_t>(y) * stride_];
             double* ai = &acc_int_[static_cast<std::size_t>(y) * stride_];
             double* out = &next_[static_cast<std::size_t>(y) * w];
-            std::size_t ci = 0;
+            // The running sums over the object's columns, composited where the row is dirty.
             double b = 0, s = 0;
+            int x = r.x0;
             for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)]) {
-                for (int x = lo; x <= hi; ++x) {
-                    while (ci < cols.size() && cols[ci] <= x) {
-                        const int c = cols[ci++];
-                        b += ac[c];
-                        if (multi) s += ai[c];
+                if (hi < r.x0) continue;
+                if (lo > r.x1) break;
+                for (; x < lo; ++x) {
+                    b += ac[x];
+                    ac[x] = 0;
+                    if (multi) {
+                        s += ai[x];
+                        ai[x] = 0;
+                    }
+                }
+                const int last = std::min(hi, r.x1);
+                for (; x <= last; ++x) {
+                    b += ac[x];
+                    ac[x] = 0;
+                    if (multi) {
+                        s += ai[x];
+                        ai[x] = 0;
                     }
                     if (b <= kSnap) continue;
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;
                     out[x] = out[x] * (1.0 - bc) + (multi ? s : bc * level);
                 }
             }
-            for (const int c : cols) {
-                ac[c] = 0;
-                ai[c] = 0;
+            // Clear what the edges left to the right of the last dirty column.
+            for (; x <= xend; ++x) {
+                ac[x] = 0;
+                if (multi) ai[x] = 0;
             }
-            cols.clear();
         }
     }
     if (all_rows) return 0;

@@ -89,7 +89,6 @@ private:
     // Per object: its pieces' polygons at the time being rendered, and the pixel rectangles
     // it covers then (rects_) and at time_us() (prev_rects_).
     std::vector<std::vector<std::vector<Vec2>>> polys_, prev_polys_;
-    std::vector<std::vector<int>> touched_;  // per row: the columns whose accumulator entries are set
     std::vector<Rect> rects_, prev_rects_;
     std::vector<char> moving_;
     std::vector<std::vector<std::pair<int, int>>> spans_;  // each row's dirty columns, inclusive, sorted, disjoint
