@@ -15,6 +15,7 @@ void add_label_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
 
 /// The input-format options every command shares (--format, --csv-columns, --time-unit, --chip).
 void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit,

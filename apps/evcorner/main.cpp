@@ -101,6 +101,7 @@ int main(int argc, char** argv) {
     evcorner::cli::add_eval_command(app);
     evcorner::cli::add_render_command(app);
     evcorner::cli::add_bench_command(app);
+    evcorner::cli::add_simulate_command(app);
     // The command list shows each command's first line; the rest of its description
     // heads its own --help, before the examples.
     for (CLI::App* cmd : app.get_subcommands({})) {

@@ -1,0 +1,107 @@
+#pragma once
+// An event-camera simulator for scenes of moving polygons (scene.hpp), after the pixel model
+// of ESIM (Rebecq, Gehrig, Scaramuzza, CoRL 2018) and v2e (Hu, Liu, Delbruck, CVPRW 2021),
+// written from their descriptions:
+//
+//   I(x, y, t)  the image: background, then each object in list order composited over it with
+//               its exact per-pixel area coverage (coverage.hpp); intensities in [0, 1]
+//   L = log(eps + I), eps = 0.001; each pixel keeps a reference level, set to L at t = 0
+//   an ON (OFF) event each time L reaches reference + C_on (reference - C_off); the
+//               reference then moves by that C. C_on, C_off ~ N(C, sigma) per pixel, drawn once
+//   crossing time: I is linear between two simulated instants (exact for an edge parallel to
+//               a pixel side moving at constant speed), so the time at which I reaches the
+//               threshold's intensity exp(reference +- C) - eps is interpolated linearly in I
+//   steps adapt so that no pixel's L changes by more than step_fraction * C between them
+//   refractory: an event less than refractory_us after the pixel's last emitted one is
+//               dropped (its reference still moves, so the pixel stays in step with the light)
+//   noise: Poisson background activity at noise_hz per pixel, random polarity, plus hot pixels
+//               (ON at hot_pixel_hz each); neither touches references nor refractory state
+//   timestamps: the crossing time rounded to the nearest microsecond (at least 1: nothing at
+//               t = 0); events sorted by (t, y, x, p) within a step, steps in time order
+//
+// Streaming: step() hands out one step's events at a time; memory is a few arrays the size
+// of the sensor, whatever the duration. Steps are also short enough that no vertex moves
+// 0.75 px; then only the pixels within a pixel of a moving edge (before or after the step)
+// can change, and only they are recomputed: the work per step follows the edges' length,
+// not the objects' area.
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "evcorner/event.hpp"
+#include "evcorner/sim/random.hpp"
+#include "evcorner/sim/scene.hpp"
+
+namespace evcorner::sim {
+
+inline constexpr double kLogEps = 0.001;
+
+struct SimStats {
+    std::uint64_t steps = 0;
+    std::uint64_t rejected_steps = 0;  ///< retried shorter: some pixel's L changed too much
+    std::uint64_t on = 0;
+    std::uint64_t off = 0;
+    std::uint64_t noise = 0;       ///< background-activity and hot-pixel events (counted in on/off too)
+    std::uint64_t refractory = 0;  ///< crossings dropped by the refractory period
+    double max_step_change = 0;    ///< largest accepted per-step |delta L| / C (bounded via |dI| / (eps + min I))
+};
+
+class Simulator {
+public:
+    explicit Simulator(Scene scene);
+
+    /// Simulates the next step and appends its events, sorted, to `out`. Returns false, and
+    /// appends nothing, once the scene's duration is reached.
+    bool step(std::vector<Event>& out);
+
+    /// Simulated time reached, microseconds (0 before the first step).
+    [[nodiscard]] double time_us() const noexcept { return t_; }
+    [[nodiscard]] const Scene& scene() const noexcept { return scene_; }
+    [[nodiscard]] const SimStats& stats() const noexcept { return stats_; }
+    /// The image at time_us(), row-major.
+    [[nodiscard]] std::span<const double> image() const noexcept { return cur_; }
+
+private:
+    struct Rect {
+        int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // inclusive; empty when x1 < x0
+        [[nodiscard]] bool empty() const noexcept { return x1 < x0 || y1 < y0; }
+    };
+    void place_objects(double t_us);  // fills polys_ and rects_ for time t
+    double render(bool all_rows);     // renders into next_ over the dirty rows; returns max |dL| bound
+    void mark_edges(const std::vector<std::vector<Vec2>>& pieces);
+    [[nodiscard]] double max_displacement() const noexcept;
+    void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
+    void emit_noise(double t1, std::vector<Event>& step_events);
+
+    Scene scene_;
+    int w_, h_;
+    std::size_t stride_;
+    double t_ = 0;
+    double dt_;
+    double end_;
+    std::vector<double> bg_, cur_, next_;
+    std::vector<double> lref_, ion_, ioff_;
+    std::vector<float> con_, coff_;
+    std::vector<std::int64_t> last_;
+    std::vector<double> acc_cov_, acc_int_;
+    // Per object: its pieces' polygons at the time being rendered, and the pixel rectangles
+    // it covers then (rects_) and at time_us() (prev_rects_).
+    std::vector<std::vector<std::vector<Vec2>>> polys_, prev_polys_;
+    std::vector<Rect> rects_, prev_rects_;
+    std::vector<char> moving_;
+    std::vector<std::vector<std::pair<int, int>>> spans_;  // each row's dirty columns, inclusive, sorted, disjoint
+    // Noise: the next background-activity time and its stream.
+    Random noise_rng_;
+    double noise_rate_per_us_ = 0;
+    double next_noise_ = 0;
+    std::vector<std::uint32_t> hot_;
+    std::vector<Event> step_events_;
+    SimStats stats_;
+};
+
+/// Every event of a scene, for tests and small scenes (the CLI streams with step()).
+std::vector<Event> simulate(const Scene& scene);
+
+}  // namespace evcorner::sim

@@ -1,0 +1,110 @@
+#include "evcorner/sim/coverage.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace evcorner::sim {
+
+namespace {
+
+// One edge from (x0, y0) to (x1, y1), y0 < y1; h for a row is sign * its y-extent there.
+template <bool Record>
+void accumulate_edge(double x0, double y0, double x1, double y1, double sign, double* acc, std::size_t stride, int width,
+                     int height, std::vector<std::vector<int>>* touched) noexcept {
+    const double dxdy = (x1 - x0) / (y1 - y0);
+    const int r0 = std::max(0, static_cast<int>(std::floor(y0)));
+    const int r1 = std::min(height - 1, static_cast<int>(std::ceil(y1)) - 1);
+    for (int r = r0; r <= r1; ++r) {
+        const double ya = std::max(y0, static_cast<double>(r));
+        const double yb = std::min(y1, static_cast<double>(r + 1));
+        if (yb <= ya) continue;
+        const double h = sign * (yb - ya);
+        double* row = acc + static_cast<std::size_t>(r) * stride;
+        [[maybe_unused]] std::vector<int>* cols = Record ? &(*touched)[static_cast<std::size_t>(r)] : nullptr;
+        const double xa = x0 + (ya - y0) * dxdy, xb = x0 + (yb - y0) * dxdy;
+        const double xl = std::min(xa, xb), xr = std::max(xa, xb);
+        if (xr <= 0) {  // wholly left of the sensor: covers every pixel of the row to its right
+            row[0] += h;
+            if constexpr (Record) cols->push_back(0);
+            continue;
+        }
+        if (xl >= width) continue;
+        if (xr == xl) {
+            const int k = static_cast<int>(std::floor(xl));
+            row[k] += h * (k + 1 - xl);
+            row[k + 1] += h * (xl - k);
+            if constexpr (Record) {
+                cols->push_back(k);
+                cols->push_back(k + 1);
+            }
+            continue;
+        }
+        const double per_x = h / (xr - xl);
+        double lo = xl;
+        if (lo < 0) {
+            row[0] += per_x * (0 - lo);
+            if constexpr (Record) cols->push_back(0);
+            lo = 0;
+        }
+        const double hi_end = std::min(xr, static_cast<double>(width));
+        int k = static_cast<int>(std::floor(lo));
+        while (lo < hi_end) {
+            const double hi = std::min(hi_end, static_cast<double>(k + 1));
+            const double hp = per_x * (hi - lo);
+            const double xm = 0.5 * (lo + hi);
+            row[k] += hp * (k + 1 - xm);
+            row[k + 1] += hp * (xm - k);
+            if constexpr (Record) {
+                cols->push_back(k);
+                cols->push_back(k + 1);
+            }
+            lo = hi;
+            ++k;
+        }
+    }
+}
+
+template <bool Record>
+void accumulate(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width, int height,
+                std::vector<std::vector<int>>* touched) noexcept {
+    const std::size_t n = poly.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec2 a = poly[i], b = poly[(i + 1) % n];
+        if (a.y == b.y) continue;  // horizontal edges bound no area to their right
+        // Upward edges (b.y < a.y) add, downward ones subtract: a positive-area polygon covers +1.
+        if (a.y < b.y)
+            accumulate_edge<Record>(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height, touched);
+        else
+            accumulate_edge<Record>(b.x, b.y, a.x, a.y, weight, acc, stride, width, height, touched);
+    }
+}
+
+}  // namespace
+
+void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
+                        int height) noexcept {
+    accumulate<false>(poly, weight, acc, stride, width, height, nullptr);
+}
+
+void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
+                        int height, std::vector<std::vector<int>>& touched) {
+    accumulate<true>(poly, weight, acc, stride, width, height, &touched);
+}
+
+std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size) {
+    const std::size_t stride = static_cast<std::size_t>(size.width) + 2;
+    std::vector<double> acc(stride * static_cast<std::size_t>(size.height), 0.0);
+    accumulate_polygon(poly, 1.0, acc.data(), stride, size.width, size.height);
+    std::vector<double> cov(static_cast<std::size_t>(size.pixels()));
+    for (int y = 0; y < size.height; ++y) {
+        double s = 0;
+        for (int x = 0; x < size.width; ++x) {
+            s += acc[static_cast<std::size_t>(y) * stride + static_cast<std::size_t>(x)];
+            cov[static_cast<std::size_t>(y) * static_cast<std::size_t>(size.width) + static_cast<std::size_t>(x)] =
+                std::clamp(s, 0.0, 1.0);
+        }
+    }
+    return cov;
+}
+
+}  // namespace evcorner::sim
