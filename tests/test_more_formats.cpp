@@ -607,9 +607,8 @@ TEST(Unsupported, EachKindIsNamedWithoutRawBytes) {
     tar.replace(0, 8, "file.txt");
     tar.replace(257, 6, std::string("ustar\0", 6));
     const std::vector<Kind> kinds = {
-        {"bag.db3", std::string("SQLite format 3\0\x10\x00\x01\x01", 20) + std::string(100, '\0'), "an SQLite 3 database"},
-        {"bag.mcap", std::string("\x89MCAP0\r\n\x01\x02\x03", 11), "an MCAP file"},
-        {"bag.bag", "#ROSBAG V2.0\nE\x00\x00\x00", "a ROS 1 bag"},
+        // (SQLite, MCAP and ROS 1 bags are read: their damage is the bag readers', test_ros_bags.cpp.)
+        {"old.bag", "#ROSBAG V1.2\n\x01\x02", "a ROS bag of an unknown version"},
         {"junk.gz", gzip_bytes(std::string(4000, '\0') + "\x01\x02\x03"), "gzip-compressed data holding binary data"},
         {"junk.zst", zstd_bytes(std::string("\x89PNG\r\n\x1a\n", 8) + std::string(100, '\0')),
          "zstd-compressed data holding a PNG image"},
@@ -642,11 +641,10 @@ TEST(Unsupported, EachKindIsNamedWithoutRawBytes) {
 }
 
 TEST_F(MoreFormatsCli, UnsupportedFormatExitsOneAndPrintsNoRawBytes) {
-    write("bag.db3", std::string("SQLite format 3\0\x10\x00\x01\x01", 20) + std::string(100, '\0'));
-    const CliResult r = run("info --no-progress bag.db3");
+    write("a.png", std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16) + std::string(64, '\x01'));
+    const CliResult r = run("info --no-progress a.png");
     EXPECT_EQ(r.status, 1);
-    EXPECT_NE(r.err.find("bag.db3: unsupported format: this looks like an SQLite 3 database"), std::string::npos)
-        << r.err;
+    EXPECT_NE(r.err.find("a.png: unsupported format: this looks like a PNG image"), std::string::npos) << r.err;
     for (const char c : r.err) EXPECT_TRUE(c == '\n' || (c >= 0x20 && c < 0x7f)) << r.err;
     // A CSV whose header row holds control bytes: quoted escaped.
     write("ctl.csv", "t,x\x1b[31m,y,p\n1,2,3,1\n");

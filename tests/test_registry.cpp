@@ -235,7 +235,7 @@ TEST(Registry, SharedKeysHaveOneType) {
     }
     const auto window = std::find_if(keys.begin(), keys.end(), [](const auto& k) { return k.key == "harris-window"; });
     ASSERT_NE(window, keys.end());
-    EXPECT_EQ(window->detectors, (std::vector<std::string_view>{"harris", "harris-global"}));
+    EXPECT_EQ(window->detectors, (std::vector<std::string_view>{"harris", "harris-global", "fa-harris", "efast-harris"}));
 }
 
 TEST(Registry, LocalityComesFromTheEntries) {

@@ -38,6 +38,39 @@
 
 namespace evcorner {
 
+// Parameter groups several detectors share (same keys, same meaning, same ranges): the
+// Harris score of a patch, the newest-Nl patch, and Arc*'s filter and arcs. P is any
+// params struct with the named fields.
+template <class P>
+std::vector<ParamField<P>> harris_score_params() {
+    return {
+        param("harris-window", &P::window, 5, 15, "patch side, odd"),
+        param("harris-k", &P::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
+        param("harris-threshold", &P::threshold, -kUnbounded, kUnbounded, "corner iff score > threshold"),
+    };
+}
+template <class P>
+std::vector<ParamField<P>> harris_patch_params() {
+    auto v = harris_score_params<P>();
+    v.insert(v.begin() + 1, param("harris-nl", &P::nl, 1, 225, "newest distinct pixels lit in the patch, at most window^2"));
+    return v;
+}
+template <class P>
+std::vector<ParamField<P>> arc_filter_params() {
+    return {
+        param("arc-filter", &P::filter, "the published filter (false: every event passes)"),
+        param("arc-filter-us", &P::filter_us, std::int64_t{0}, ArcStar::kMaxFilterUs,
+              "filter window in us: an event passes when its pixel's last one is older by more"),
+        param("arc-minority-only", &P::minority_only, "accept only minority arcs (3..6, 4..8), not the majority arcs"),
+        param("arc-zero-init", &P::zero_init, "the authors' zero-initialised filter (a never-fired pixel reads as t = 0)"),
+    };
+}
+template <class P>
+std::vector<ParamField<P>> operator+(std::vector<ParamField<P>> a, const std::vector<ParamField<P>>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
+
 /// THE list: one entry per detector, in the order --help lists them. Keys of parameters
 /// are global: a key several detectors take (harris-window) means the same thing for
 /// each and has the same type.
@@ -58,28 +91,17 @@ inline const auto& detector_registry() {
         DetectorEntry<Harris>{
             .name = "harris",
             .summary = "spatially-adaptive Harris (Mueggler et al., BMVC 2017, Sec. 3.2): newest Nl pixels of the window",
-            .params =
-                {
-                    param("harris-window", &HarrisParams::window, 5, 15, "patch side, odd"),
-                    param("harris-nl", &HarrisParams::nl, 1, 225, "newest distinct pixels lit in the patch, at most window^2"),
-                    param("harris-k", &HarrisParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
-                    param("harris-threshold", &HarrisParams::threshold, -kUnbounded, kUnbounded, "corner iff score > threshold"),
-                },
+            .params = harris_patch_params<HarrisParams>(),
             .split = Split::by_polarity,
             .radius = [](const HarrisParams& p) { return p.window / 2; },
         },
         DetectorEntry<HarrisGlobal>{
             .name = "harris-global",
             .summary = "event-based Harris (Vasco et al., IROS 2016): newest N pixels of the sensor",
-            .params =
-                {
-                    param("harris-window", &HarrisGlobalParams::window, 5, 15, "patch side, odd"),
-                    param("harris-n", &HarrisGlobalParams::n, 1, 2147483647,
-                          "newest distinct pixels lit over the sensor per polarity (1000 or 2000 in Vasco et al.)"),
-                    param("harris-k", &HarrisGlobalParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
-                    param("harris-threshold", &HarrisGlobalParams::threshold, -kUnbounded, kUnbounded,
-                          "corner iff score > threshold"),
-                },
+            .params = harris_score_params<HarrisGlobalParams>() +
+                      std::vector{param("harris-n", &HarrisGlobalParams::n, 1, 2147483647,
+                                        "newest distinct pixels lit over the sensor per polarity (1000 or 2000 in "
+                                        "Vasco et al.)")},
             .split = Split::none,
             .not_local = "its surface holds the newest N pixels of the whole sensor",
         },
@@ -87,16 +109,7 @@ inline const auto& detector_registry() {
             .name = "arcstar",
             .summary = "Arc* (Alzugaray and Chli, RA-L 2018): 50 ms filter, then its arc test on the radius-3/4 circles, "
                        "majority arcs included",
-            .params =
-                {
-                    param("arc-filter", &ArcStarParams::filter, "the published filter (false: every event passes)"),
-                    param("arc-filter-us", &ArcStarParams::filter_us, std::int64_t{0}, ArcStar::kMaxFilterUs,
-                          "filter window in us: an event passes when its pixel's last one is older by more"),
-                    param("arc-minority-only", &ArcStarParams::minority_only,
-                          "accept only minority arcs (3..6, 4..8), not the majority arcs"),
-                    param("arc-zero-init", &ArcStarParams::zero_init,
-                          "the authors' zero-initialised filter (a never-fired pixel reads as t = 0)"),
-                },
+            .params = arc_filter_params<ArcStarParams>(),
             .split = Split::by_rows,
             .radius = [](const ArcStarParams&) { return kCircleMargin; },
         },
@@ -104,34 +117,18 @@ inline const auto& detector_registry() {
             .name = "fa-harris",
             .summary = "FA-Harris (Li et al., IROS 2019): Arc* candidates refined by the adaptive Harris on the newest "
                        "filtered pixels",
-            .params =
-                {
-                    param("arc-filter", &FaHarrisParams::filter, "the published filter (false: every event passes)"),
-                    param("arc-filter-us", &FaHarrisParams::filter_us, std::int64_t{0}, ArcStar::kMaxFilterUs,
-                          "filter window in us: an event passes when its pixel's last one is older by more"),
-                    param("arc-minority-only", &FaHarrisParams::minority_only,
-                          "accept only minority arcs (3..6, 4..8), not the majority arcs"),
-                    param("arc-zero-init", &FaHarrisParams::zero_init,
-                          "the authors' zero-initialised filter (a never-fired pixel reads as t = 0)"),
-                    param("harris-window", &FaHarrisParams::window, 5, 15, "patch side, odd"),
-                    param("harris-nl", &FaHarrisParams::nl, 1, 225, "newest distinct pixels lit in the patch, at most window^2"),
-                    param("harris-k", &FaHarrisParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
-                    param("harris-threshold", &FaHarrisParams::threshold, -kUnbounded, kUnbounded, "corner iff score > threshold"),
-                },
+            .params = arc_filter_params<FaHarrisParams>() + harris_patch_params<FaHarrisParams>(),
             .split = Split::by_rows,
-            .radius = [](const FaHarrisParams& p) { return std::max(kCircleMargin, p.window / 2); },
+            // A border event changes no state: in a part (parallel_detect.hpp) the rows within
+            // kCircleMargin of the part's edge are border rows, so the halo holds those on top
+            // of the rows an event reads (the circles and the Harris window).
+            .radius = [](const FaHarrisParams& p) { return std::max(kCircleMargin, p.window / 2) + kCircleMargin; },
         },
         DetectorEntry<EFastHarris>{
             .name = "efast-harris",
             .summary = "eFAST -> Harris cascade (Mueggler et al., BMVC 2017, Sec. 4): eFAST corners the adaptive Harris "
                        "also scores above its threshold",
-            .params =
-                {
-                    param("harris-window", &HarrisParams::window, 5, 15, "patch side, odd"),
-                    param("harris-nl", &HarrisParams::nl, 1, 225, "newest distinct pixels lit in the patch, at most window^2"),
-                    param("harris-k", &HarrisParams::k, -kUnbounded, kUnbounded, "k in H = det - k trace^2"),
-                    param("harris-threshold", &HarrisParams::threshold, -kUnbounded, kUnbounded, "corner iff score > threshold"),
-                },
+            .params = harris_patch_params<HarrisParams>(),
             .split = Split::by_polarity,
             .radius = [](const HarrisParams& p) { return std::max(kCircleMargin, p.window / 2); },
         },

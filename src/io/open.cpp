@@ -57,7 +57,7 @@ struct Magic {
     std::string_view hint;
 };
 constexpr std::string_view kAny = "";
-const std::array<Magic, 24> kMagics = {{
+const Magic kMagics[] = {
     {0, "MATLAB 5.0 MAT-file", "mat", "a MATLAB 5.0 MAT-file", kAny},
     {0, "MATLAB 7.3 MAT-file", "mat", "a MATLAB 7.3 MAT-file", kAny},
     {0, "#ROSBAG", "", "a ROS bag of an unknown version", kAny},
@@ -81,7 +81,7 @@ const std::array<Magic, 24> kMagics = {{
     {0, "PAR1", "", "an Apache Parquet file", kAny},
     {257, "ustar", "", "a tar archive", "extract it and pass the event file inside"},
     {4, "ftyp", "", "an MP4/MOV video", kAny},
-}};
+};
 
 // Thrown for a file no reader takes: what it looks like, never its raw bytes.
 [[noreturn]] void unsupported(const InputFile& file, std::string_view what, std::string_view hint) {
