@@ -51,6 +51,8 @@ void check_circles(std::uint64_t seed, int count, int (&sizes)[N + 1]) {
             if (c[k] > c[first_max]) first_max = k;
         ASSERT_EQ(newest, first_max);
         ASSERT_EQ((arcstar_arc_size<N, Lmin, Lmax>(t, newest)), expected) << "circle #" << i;
+        // The closed form (the AVX-512 path's definition) gives the same size.
+        ASSERT_EQ(naive::arcstar_size_by_separation<N>(c, Lmin), expected) << "circle #" << i;
         // The shortcut, when it speaks, is right.
         if (arcstar_surely_full<N, Lmin, Search>(t, newest)) {
             ASSERT_EQ(expected, N) << "circle #" << i;
@@ -84,6 +86,40 @@ TEST(ArcStarArc, Avx2PathEqualsTheDefinition) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU";
     int s16[17] = {}, s20[21] = {};
     check_avx2(s16, s20);
+}
+#endif
+
+// The AVX-512 path (closed form, all arcs at once) against the step-by-step definition.
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+template <int N, int Lmin, int Lmax>
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] void check_circles_avx512(std::uint64_t seed, int count,
+                                                                              int (&sizes)[N + 1]) {
+    std::mt19937_64 rng(seed);
+    std::int64_t offsets[N];
+    for (int k = 0; k < N; ++k) offsets[k] = k;
+    for (int i = 0; i < count; ++i) {
+        const auto c = random_circle<N>(rng);
+        ++sizes[naive::arcstar_size_naive<N>(c, Lmin)];
+        for (bool minority : {false, true}) {
+            bool passes;
+            if constexpr (N == 16)
+                passes = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load16(c.data(), offsets), minority);
+            else
+                passes = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load20(c.data(), offsets), minority);
+            ASSERT_EQ(passes, naive::arcstar_arc_naive<N>(c, Lmin, Lmax, minority)) << "circle #" << i;
+        }
+    }
+}
+TEST(ArcStarArc, Avx512PathEqualsTheDefinition) {
+    __builtin_cpu_init();
+    if (!(__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq")))
+        GTEST_SKIP() << "no AVX-512 on this CPU";
+    int s16[17] = {}, s20[21] = {};
+    check_circles_avx512<16, 3, 6>(5, 200000, s16);
+    check_circles_avx512<20, 4, 8>(6, 200000, s20);
+    for (int s = 3; s <= 16; ++s) EXPECT_GT(s16[s], 0) << "size " << s;
+    for (int s = 4; s <= 20; ++s) EXPECT_GT(s20[s], 0) << "size " << s;
 }
 #endif
 

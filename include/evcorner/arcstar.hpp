@@ -96,10 +96,18 @@ private:
         int height;
         std::int64_t window;
         bool filter, minority_only, zero_init;
+        ArcStarCircles circles;
 
         static View make(ArcStar& d) noexcept {
-            return {{d.sae_.plane(0), d.sae_.plane(1)}, d.latest_.data(), d.sae_.size().width, d.sae_.size().height,
-                    d.params_.filter_us, d.params_.filter, d.params_.minority_only, d.params_.zero_init};
+            return {{d.sae_.plane(0), d.sae_.plane(1)},
+                    d.latest_.data(),
+                    d.sae_.size().width,
+                    d.sae_.size().height,
+                    d.params_.filter_us,
+                    d.params_.filter,
+                    d.params_.minority_only,
+                    d.params_.zero_init,
+                    ArcStarCircles(d.sae_.size().width)};
         }
 
         template <class Search>
@@ -116,11 +124,7 @@ private:
             if (e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
                 e.y >= height - kCircleMargin)
                 return false;
-            const std::ptrdiff_t w = width;
-            return arcstar_circle_passes<kCircle3.size(), kArc3Min, kArc3Max, Search>(
-                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only) &&
-                   arcstar_circle_passes<kCircle4.size(), kArc4Min, kArc4Max, Search>(
-                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+            return circles.pass<Search, kArc3Min, kArc3Max, kArc4Min, kArc4Max>(centre, minority_only);
         }
     };
 
@@ -130,11 +134,14 @@ private:
 };
 static_assert(Detector<ArcStar>);
 
-/// detect() for Arc*: the same flags, with the fastest newest-pixel search this CPU runs
-/// (AVX2 where it has it, else portable), chosen once per process. Checks as the generic
+/// detect() for Arc*: the same flags, with the fastest code this CPU runs (AVX-512, else
+/// AVX2, else portable), chosen once per process; EVCORNER_ARCSTAR_PATH=portable|avx2|avx512
+/// forces one this CPU runs. Checks as the generic
 /// detect() does (InvalidEvent before any event is processed).
 std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
 /// detect() without the checks.
 std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+/// The code path detect() runs: "avx512", "avx2" or "portable".
+const char* arcstar_code_path() noexcept;
 
 }  // namespace evcorner

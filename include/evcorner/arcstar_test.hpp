@@ -18,7 +18,10 @@
 
 #include <cstdint>
 
+#include <type_traits>
+
 #include "evcorner/arc_test.hpp"
+#include "evcorner/circle.hpp"
 #include "evcorner/sae.hpp"
 
 namespace evcorner {
@@ -243,5 +246,80 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
     if (arcstar_surely_full<N, Lmin, Search>(t, newest)) return arcstar_size_passes<N, Lmin, Lmax>(N, minority_only);
     return arcstar_size_passes<N, Lmin, Lmax>(arcstar_arc_size<N, Lmin, Lmax>(t, newest), minority_only);
 }
+
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+/// Arc*'s arc test by its closed form (docs/arcstar.md, "The size in closed form"): the
+/// growth ends with size S = the smallest L >= Lmin for which some arc of L pixels is
+/// *separating* (its oldest strictly newer than every pixel outside it), or N if none.
+/// So the circle passes iff a separating arc has a length in Lmin..Lmax, or (unless
+/// minority_only) none has a length in Lmax+1..N-Lmax-1 and one has a length in
+/// N-Lmax..N-Lmin. Each length's test for all arcs at once is eFAST's AVX-512 one
+/// (Avx512Search: sliding minima and maxima over the circle in vector registers), so
+/// there is no serial growth and no data-dependent branch. Only for code compiled for
+/// AVX-512.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+struct ArcStarAvx512 {
+    // Whether some arc of a length in Lo..Hi is separating (false for an empty range).
+    template <int N, int Lo, int Hi, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool any_separating(const C& t) noexcept {
+        unsigned any = 0;
+        if constexpr (Lo <= Hi) {
+            [&]<int... I>(std::integer_sequence<int, I...>) {
+                ((any |= any_greater(Avx512Search::sliding<Lo + I, false>(t),
+                                     Avx512Search::sliding<N - Lo - I, true>(t).template rot<Lo + I>())),
+                 ...);
+            }(std::make_integer_sequence<int, Hi - Lo + 1>{});
+        }
+        return any != 0;
+    }
+    template <int N, int Lmin, int Lmax, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool passes(const C& t, bool minority_only) noexcept {
+        const bool minority = any_separating<N, Lmin, Lmax>(t);
+        const bool between = any_separating<N, Lmax + 1, N - Lmax - 1>(t);
+        const bool majority = any_separating<N, N - Lmax, N - Lmin>(t);
+        return minority | (!minority_only & !between & majority);
+    }
+};
+#pragma GCC diagnostic pop
+#endif
+
+/// Both Arc* circles around a pixel of an SAE plane `width` cells wide: the radius-3
+/// test, then (only if it passed) the radius-4 one. Shared by ArcStar and FA-Harris.
+class ArcStarCircles {
+public:
+    explicit ArcStarCircles(std::ptrdiff_t width) noexcept : width_(width) {
+        // The AVX-512 path loads the circles through offset tables (as eFAST's does).
+        for (int k = 0; k < 16; ++k) off3_[k] = kCircle3[k].dy * width + kCircle3[k].dx;
+        for (int k = 0; k < 20; ++k) off4_[k] = kCircle4[k].dy * width + kCircle4[k].dx;
+    }
+
+    template <class Search, int Lmin3, int Lmax3, int Lmin4, int Lmax4>
+    [[nodiscard]] bool pass(const std::int64_t* centre, bool minority_only) const noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        if constexpr (std::is_same_v<Search, Avx512Search>) {
+            return ArcStarAvx512::passes<16, Lmin3, Lmax3>(Avx512Search::load16(centre, off3_), minority_only) &&
+                   ArcStarAvx512::passes<20, Lmin4, Lmax4>(Avx512Search::load20(centre, off4_), minority_only);
+        } else
+#endif
+        {
+            // Offsets from compile-time circle coordinates: rows centre + dy * width with
+            // constant column offsets.
+            const std::ptrdiff_t w = width_;
+            return arcstar_circle_passes<kCircle3.size(), Lmin3, Lmax3, Search>(
+                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only) &&
+                   arcstar_circle_passes<kCircle4.size(), Lmin4, Lmax4, Search>(
+                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+        }
+    }
+
+private:
+    std::ptrdiff_t width_;
+    std::int64_t off3_[16];
+    std::int64_t off4_[20];
+};
 
 }  // namespace evcorner
