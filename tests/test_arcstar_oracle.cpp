@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <random>
 #include <string>
@@ -100,13 +101,27 @@ template <int N, int Lmin, int Lmax>
     for (int i = 0; i < count; ++i) {
         const auto c = random_circle<N>(rng);
         ++sizes[naive::arcstar_size_naive<N>(c, Lmin)];
+        // The event's stored time: just after the newest pixel (32-bit relative times), or
+        // far away (some or all fired pixels beyond +-2^31: the 64-bit fallback).
+        std::int64_t newest = 0;
+        for (std::int64_t v : c) newest = std::max(newest, v);
+        const std::int64_t st_near = newest + static_cast<std::int64_t>(rng() % 1000);
+        const std::int64_t st_far = (std::int64_t{1} << 31) + static_cast<std::int64_t>(rng() % 2000000);
         for (bool minority : {false, true}) {
-            bool passes;
-            if constexpr (N == 16)
-                passes = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load16(c.data(), offsets), minority);
-            else
-                passes = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load20(c.data(), offsets), minority);
-            ASSERT_EQ(passes, naive::arcstar_arc_naive<N>(c, Lmin, Lmax, minority)) << "circle #" << i;
+            const bool want = naive::arcstar_arc_naive<N>(c, Lmin, Lmax, minority);
+            bool wide, near, far;
+            if constexpr (N == 16) {
+                wide = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load16(c.data(), offsets), minority);
+                near = ArcStarAvx512::circle16_passes(c.data(), offsets, st_near, minority);
+                far = ArcStarAvx512::circle16_passes(c.data(), offsets, st_far, minority);
+            } else {
+                wide = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load20(c.data(), offsets), minority);
+                near = ArcStarAvx512::circle20_passes(c.data(), offsets, st_near, minority);
+                far = ArcStarAvx512::circle20_passes(c.data(), offsets, st_far, minority);
+            }
+            ASSERT_EQ(wide, want) << "circle #" << i;
+            ASSERT_EQ(near, want) << "circle #" << i;
+            ASSERT_EQ(far, want) << "circle #" << i;
         }
     }
 }

@@ -253,28 +253,106 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
 /// *separating* (its oldest strictly newer than every pixel outside it), or N if none.
 /// So the circle passes iff a separating arc has a length in Lmin..Lmax, or (unless
 /// minority_only) none has a length in Lmax+1..N-Lmax-1 and one has a length in
-/// N-Lmax..N-Lmin. Each length's test for all arcs at once is eFAST's AVX-512 one
-/// (Avx512Search: sliding minima and maxima over the circle in vector registers), so
-/// there is no serial growth and no data-dependent branch. Only for code compiled for
-/// AVX-512.
+/// N-Lmax..N-Lmin. Every length is tested for all arcs at once as eFAST's AVX-512 path
+/// does (sliding minima and maxima over the circle in vector registers), so there is no
+/// serial growth and no data-dependent branch. Only for code compiled for AVX-512.
+///
+/// The circle is held as 32-bit times relative to the event's (order is all the test
+/// reads): 16 pixels fill one register instead of two. That is exact while every fired
+/// pixel of the circle lies within +-2^31 us (35 minutes) of the event; never-fired pixels
+/// become INT32_MIN, older than all of them. A circle outside that range (never on the
+/// real files) takes the same test on the 64-bit circles of Avx512Search.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 struct ArcStarAvx512 {
-    // Whether some arc of a length in Lo..Hi is separating (false for an empty range).
+    // 16 pixels as 32-bit values in one register.
+    struct Circle16 {
+        __m512i v;
+        // t[k + J] (mod 16) in lane k.
+        template <int J>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Circle16 rot() const noexcept {
+            constexpr int j = J % 16;
+            if constexpr (j == 0) return *this;
+            else return {_mm512_alignr_epi32(v, v, j)};
+        }
+    };
+    // 20 pixels as 32-bit values extended periodically to 48 lanes (lane m: t[m mod 20]) in
+    // three registers, so that any 16 cyclically consecutive pixels are one valignd away.
+    struct Circle20 {
+        __m512i v[3];
+        template <int A>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] __m512i window() const noexcept {
+            static_assert(A < 32);
+            if constexpr (A % 16 == 0) return v[A / 16];
+            else return _mm512_alignr_epi32(v[A / 16 + 1], v[A / 16], A % 16);
+        }
+        template <int J>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Circle20 rot() const noexcept {
+            constexpr int j = J % 20;
+            return {{window<j>(), window<(16 + j) % 20>(), window<(32 + j) % 20>()}};
+        }
+    };
+
+    // Lane by lane min or max, and the lanes (of the circle's N) where a > b, per circle type.
+    template <bool Max>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Circle16 lanes(const Circle16& a, const Circle16& b) noexcept {
+        return {Max ? _mm512_max_epi32(a.v, b.v) : _mm512_min_epi32(a.v, b.v)};
+    }
+    template <bool Max>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Circle20 lanes(const Circle20& a, const Circle20& b) noexcept {
+        Circle20 r;
+        for (int i = 0; i < 3; ++i) r.v[i] = Max ? _mm512_max_epi32(a.v[i], b.v[i]) : _mm512_min_epi32(a.v[i], b.v[i]);
+        return r;
+    }
+    template <bool Max, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static C lanes(const C& a, const C& b) noexcept {
+        return Avx512Search::lanes<Max>(a, b);  // the 64-bit circles
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Circle16& a, const Circle16& b) noexcept {
+        return _mm512_cmpgt_epi32_mask(a.v, b.v);
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Circle20& a, const Circle20& b) noexcept {
+        return _kor_mask16(_mm512_cmpgt_epi32_mask(a.v[0], b.v[0]), _mm512_mask_cmpgt_epi32_mask(0xF, a.v[1], b.v[1]));
+    }
+    template <class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const C& a, const C& b) noexcept {
+        return static_cast<__mmask16>(any_greater(a, b));  // the 64-bit circles
+    }
+
+    // The min (Max = false) or max of L pixels in lane s: t[s .. s+L-1] (Before = false) or
+    // t[s-L .. s-1] (Before = true). The rest of the arc of L pixels from s is the N-L pixels
+    // before s, so the oldest of every arc and the newest of every rest come out in the same
+    // lane, with no rotation per length. Built from a power-of-two window and the rest, as
+    // Avx512Search::sliding; shared sub-windows are computed once (the intrinsics are pure).
+    template <int N, int L, bool Max, bool Before, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline C window(const C& t) noexcept {
+        if constexpr (L == 1) {
+            if constexpr (Before) return t.template rot<N - 1>();
+            else return t;
+        } else {
+            constexpr int h = (L & (L - 1)) == 0 ? L / 2 : 1 << (31 - __builtin_clz(static_cast<unsigned>(L)));
+            return lanes<Max>(window<N, h, Max, Before>(t),
+                              window<N, L - h, Max, Before>(t).template rot<Before ? N - h : h>());
+        }
+    }
+    // The lanes s where some arc of a length in L..Hi from s is separating (0 if L > Hi).
+    // Mask registers throughout (kor): no round trip through general registers per length.
+    template <int N, int L, int Hi, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __mmask16 separating(const C& t) noexcept {
+        if constexpr (L > Hi) {
+            return 0;
+        } else {
+            const __mmask16 here = greater(window<N, L, false, false>(t), window<N, N - L, true, true>(t));
+            if constexpr (L == Hi) return here;
+            else return _kor_mask16(here, separating<N, L + 1, Hi>(t));
+        }
+    }
     template <int N, int Lo, int Hi, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool any_separating(const C& t) noexcept {
-        unsigned any = 0;
-        if constexpr (Lo <= Hi) {
-            [&]<int... I>(std::integer_sequence<int, I...>) {
-                ((any |= any_greater(Avx512Search::sliding<Lo + I, false>(t),
-                                     Avx512Search::sliding<N - Lo - I, true>(t).template rot<Lo + I>())),
-                 ...);
-            }(std::make_integer_sequence<int, Hi - Lo + 1>{});
-        }
-        return any != 0;
+        return separating<N, Lo, Hi>(t) != 0;
     }
     template <int N, int Lmin, int Lmax, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool passes(const C& t, bool minority_only) noexcept {
@@ -282,6 +360,52 @@ struct ArcStarAvx512 {
         const bool between = any_separating<N, Lmax + 1, N - Lmax - 1>(t);
         const bool majority = any_separating<N, N - Lmax, N - Lmin>(t);
         return minority | (!minority_only & !between & majority);
+    }
+
+    // 8 stored times as 32-bit times relative to `st`, and the lanes where that is not
+    // exact (a fired pixel more than 2^31 - 1 us away): saturating narrowing, so a
+    // never-fired pixel (stored 0) becomes INT32_MIN.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i relative(__m512i q, __m512i st,
+                                                                        __mmask8& inexact) noexcept {
+        const __m512i d = _mm512_sub_epi64(q, st);
+        // d within [INT32_MIN + 1, INT32_MAX]  <=>  unsigned(d - (INT32_MIN + 1)) <= 2^32 - 2
+        const __m512i u = _mm512_sub_epi64(d, _mm512_set1_epi64(std::int64_t{INT32_MIN} + 1));
+        inexact |= _mm512_mask_cmpgt_epu64_mask(_mm512_test_epi64_mask(q, q), u,
+                                                _mm512_set1_epi64((std::int64_t{1} << 32) - 2));
+        return _mm512_cvtsepi64_epi32(d);
+    }
+
+    /// Both circles' tests with pixel k at centre[off3[k]] and centre[off4[k]], for an event
+    /// of stored time st.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_passes(const std::int64_t* centre,
+                                                                            const std::int64_t* off, std::int64_t st,
+                                                                            bool minority_only) noexcept {
+        constexpr int N = 16, Lmin = 3, Lmax = 6;
+        const Avx512Search::Circle16 wide = Avx512Search::load16(centre, off);
+        const __m512i vst = _mm512_set1_epi64(st);
+        __mmask8 inexact = 0;
+        const __m256i lo = relative(wide.v[0], vst, inexact), hi = relative(wide.v[1], vst, inexact);
+        if (inexact != 0) [[unlikely]]
+            return passes<N, Lmin, Lmax>(wide, minority_only);
+        return passes<N, Lmin, Lmax>(Circle16{_mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1)}, minority_only);
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle20_passes(const std::int64_t* centre,
+                                                                            const std::int64_t* off, std::int64_t st,
+                                                                            bool minority_only) noexcept {
+        constexpr int N = 20, Lmin = 4, Lmax = 8;
+        const Avx512Search::Circle20 wide = Avx512Search::load20(centre, off);  // t[0..8) t[8..16) t[16..20) t[0..4) ...
+        const __m512i vst = _mm512_set1_epi64(st);
+        __mmask8 inexact = 0;
+        const __m256i a = relative(wide.v[0], vst, inexact), b = relative(wide.v[1], vst, inexact);
+        const __m256i c = relative(wide.v[2], vst, inexact);  // t[16..20) t[0..4)
+        if (inexact != 0) [[unlikely]]
+            return passes<N, Lmin, Lmax>(wide, minority_only);
+        const __m512i v0 = _mm512_inserti64x4(_mm512_castsi256_si512(a), b, 1);  // t[0..16)
+        // t[16..20) into lanes 12..15, then t[16..20) t[0..12) and t[12..20) t[0..8).
+        const __m512i c12 = _mm512_inserti32x4(v0, _mm256_castsi256_si128(c), 3);
+        const __m512i v1 = _mm512_alignr_epi32(v0, c12, 12);
+        const __m512i v2 = _mm512_alignr_epi32(v1, v0, 12);
+        return passes<N, Lmin, Lmax>(Circle20{{v0, v1, v2}}, minority_only);
     }
 };
 #pragma GCC diagnostic pop
@@ -297,12 +421,14 @@ public:
         for (int k = 0; k < 20; ++k) off4_[k] = kCircle4[k].dy * width + kCircle4[k].dx;
     }
 
+    /// `centre` holds the event's own stored time (the caller has just written it).
     template <class Search, int Lmin3, int Lmax3, int Lmin4, int Lmax4>
     [[nodiscard]] bool pass(const std::int64_t* centre, bool minority_only) const noexcept {
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
         if constexpr (std::is_same_v<Search, Avx512Search>) {
-            return ArcStarAvx512::passes<16, Lmin3, Lmax3>(Avx512Search::load16(centre, off3_), minority_only) &&
-                   ArcStarAvx512::passes<20, Lmin4, Lmax4>(Avx512Search::load20(centre, off4_), minority_only);
+            static_assert(Lmin3 == 3 && Lmax3 == 6 && Lmin4 == 4 && Lmax4 == 8);
+            return ArcStarAvx512::circle16_passes(centre, off3_, *centre, minority_only) &&
+                   ArcStarAvx512::circle20_passes(centre, off4_, *centre, minority_only);
         } else
 #endif
         {
