@@ -101,6 +101,14 @@ template <int N, int Lmin, int Lmax>
     for (int i = 0; i < count; ++i) {
         const auto c = random_circle<N>(rng);
         ++sizes[naive::arcstar_size_naive<N>(c, Lmin)];
+        // The circle drawn on a 9x9 grid (as a detector's plane holds it) around its centre.
+        constexpr std::ptrdiff_t kGrid = 9;
+        constexpr std::ptrdiff_t centre = 4 * kGrid + 4;
+        std::array<std::int64_t, kGrid * kGrid> grid{};
+        for (int k = 0; k < N; ++k) {
+            const Offset o = N == 16 ? kCircle3[k] : kCircle4[k];
+            grid[static_cast<std::size_t>(centre + o.dy * kGrid + o.dx)] = c[k];
+        }
         // The event's stored time: just after the newest pixel (32-bit relative times), or
         // far away (some or all fired pixels beyond +-2^31: the 64-bit fallback).
         std::int64_t newest = 0;
@@ -112,12 +120,12 @@ template <int N, int Lmin, int Lmax>
             bool wide, near, far;
             if constexpr (N == 16) {
                 wide = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load16(c.data(), offsets), minority);
-                near = ArcStarAvx512::circle16_passes(c.data(), offsets, st_near, minority);
-                far = ArcStarAvx512::circle16_passes(c.data(), offsets, st_far, minority);
+                near = ArcStarAvx512::circle16_passes(grid.data() + centre, kGrid, st_near, minority);
+                far = ArcStarAvx512::circle16_passes(grid.data() + centre, kGrid, st_far, minority);
             } else {
                 wide = ArcStarAvx512::passes<N, Lmin, Lmax>(Avx512Search::load20(c.data(), offsets), minority);
-                near = ArcStarAvx512::circle20_passes(c.data(), offsets, st_near, minority);
-                far = ArcStarAvx512::circle20_passes(c.data(), offsets, st_far, minority);
+                near = ArcStarAvx512::circle20_passes(grid.data() + centre, kGrid, st_near, minority);
+                far = ArcStarAvx512::circle20_passes(grid.data() + centre, kGrid, st_far, minority);
             }
             ASSERT_EQ(wide, want) << "circle #" << i;
             ASSERT_EQ(near, want) << "circle #" << i;

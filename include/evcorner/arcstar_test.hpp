@@ -19,6 +19,7 @@
 #include <cstdint>
 
 #include <type_traits>
+#include <utility>
 
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
@@ -375,32 +376,58 @@ struct ArcStarAvx512 {
         return _mm512_cvtsepi64_epi32(d);
     }
 
-    /// Both circles' tests with pixel k at centre[off3[k]] and centre[off4[k]], for an event
-    /// of stored time st.
+    // Pixels K..K+3 of a circle (array of Offset) around `centre` in a row of width `w`, as
+    // 64-bit lanes. Each address is centre + dy * w + dx with dy, dx constants, so the loads
+    // need no offset table (which the loop would keep on the stack), and each goes straight
+    // into a vector register (vmovq / vpinsrq from memory).
+    template <const auto& Circle, int K>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i quad(const std::int64_t* centre,
+                                                                     std::ptrdiff_t w) noexcept {
+        const auto pair = [centre, w](int k) {
+            return std::pair{centre + Circle[k].dy * w + Circle[k].dx, centre + Circle[k + 1].dy * w + Circle[k + 1].dx};
+        };
+        const auto [a, b] = pair(K);
+        const auto [c, d] = pair(K + 2);
+        const __m128i lo = _mm_insert_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a)), *b, 1);
+        const __m128i hi = _mm_insert_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(c)), *d, 1);
+        return _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m512i octet(__m256i lo, __m256i hi) noexcept {
+        return _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1);
+    }
+
+    /// The radius-3 test around `centre` (rows `w` cells wide) for an event of stored time st.
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_passes(const std::int64_t* centre,
-                                                                            const std::int64_t* off, std::int64_t st,
+                                                                            std::ptrdiff_t w, std::int64_t st,
                                                                             bool minority_only) noexcept {
         constexpr int N = 16, Lmin = 3, Lmax = 6;
-        const Avx512Search::Circle16 wide = Avx512Search::load16(centre, off);
+        const __m256i q0 = quad<kCircle3, 0>(centre, w), q1 = quad<kCircle3, 4>(centre, w);
+        const __m256i q2 = quad<kCircle3, 8>(centre, w), q3 = quad<kCircle3, 12>(centre, w);
+        const Avx512Search::Circle16 wide{{octet(q0, q1), octet(q2, q3)}};
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;
         const __m256i lo = relative(wide.v[0], vst, inexact), hi = relative(wide.v[1], vst, inexact);
         if (inexact != 0) [[unlikely]]
             return passes<N, Lmin, Lmax>(wide, minority_only);
-        return passes<N, Lmin, Lmax>(Circle16{_mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1)}, minority_only);
+        return passes<N, Lmin, Lmax>(Circle16{octet(lo, hi)}, minority_only);
     }
+    /// The radius-4 test, the same way.
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle20_passes(const std::int64_t* centre,
-                                                                            const std::int64_t* off, std::int64_t st,
+                                                                            std::ptrdiff_t w, std::int64_t st,
                                                                             bool minority_only) noexcept {
         constexpr int N = 20, Lmin = 4, Lmax = 8;
-        const Avx512Search::Circle20 wide = Avx512Search::load20(centre, off);  // t[0..8) t[8..16) t[16..20) t[0..4) ...
+        const __m256i q0 = quad<kCircle4, 0>(centre, w), q1 = quad<kCircle4, 4>(centre, w);
+        const __m256i q2 = quad<kCircle4, 8>(centre, w), q3 = quad<kCircle4, 12>(centre, w);
+        const __m256i q4 = quad<kCircle4, 16>(centre, w);
+        // t[0..8) t[8..16) t[16..20) t[0..4): Avx512Search::Circle20's first three vectors.
+        const __m512i w0 = octet(q0, q1), w1 = octet(q2, q3), w2 = octet(q4, q0);
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;
-        const __m256i a = relative(wide.v[0], vst, inexact), b = relative(wide.v[1], vst, inexact);
-        const __m256i c = relative(wide.v[2], vst, inexact);  // t[16..20) t[0..4)
+        const __m256i a = relative(w0, vst, inexact), b = relative(w1, vst, inexact), c = relative(w2, vst, inexact);
         if (inexact != 0) [[unlikely]]
-            return passes<N, Lmin, Lmax>(wide, minority_only);
-        const __m512i v0 = _mm512_inserti64x4(_mm512_castsi256_si512(a), b, 1);  // t[0..16)
+            return passes<N, Lmin, Lmax>(Avx512Search::Circle20{{w0, w1, w2, _mm512_alignr_epi64(w1, w0, 4)}},
+                                         minority_only);
+        const __m512i v0 = octet(a, b);  // t[0..16)
         // t[16..20) into lanes 12..15, then t[16..20) t[0..12) and t[12..20) t[0..8).
         const __m512i c12 = _mm512_inserti32x4(v0, _mm256_castsi256_si128(c), 3);
         const __m512i v1 = _mm512_alignr_epi32(v0, c12, 12);
@@ -415,11 +442,7 @@ struct ArcStarAvx512 {
 /// test, then (only if it passed) the radius-4 one. Shared by ArcStar and FA-Harris.
 class ArcStarCircles {
 public:
-    explicit ArcStarCircles(std::ptrdiff_t width) noexcept : width_(width) {
-        // The AVX-512 path loads the circles through offset tables (as eFAST's does).
-        for (int k = 0; k < 16; ++k) off3_[k] = kCircle3[k].dy * width + kCircle3[k].dx;
-        for (int k = 0; k < 20; ++k) off4_[k] = kCircle4[k].dy * width + kCircle4[k].dx;
-    }
+    explicit ArcStarCircles(std::ptrdiff_t width) noexcept : width_(width) {}
 
     /// `centre` holds the event's own stored time (the caller has just written it).
     template <class Search, int Lmin3, int Lmax3, int Lmin4, int Lmax4>
@@ -427,8 +450,8 @@ public:
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
         if constexpr (std::is_same_v<Search, Avx512Search>) {
             static_assert(Lmin3 == 3 && Lmax3 == 6 && Lmin4 == 4 && Lmax4 == 8);
-            return ArcStarAvx512::circle16_passes(centre, off3_, *centre, minority_only) &&
-                   ArcStarAvx512::circle20_passes(centre, off4_, *centre, minority_only);
+            return ArcStarAvx512::circle16_passes(centre, width_, *centre, minority_only) &&
+                   ArcStarAvx512::circle20_passes(centre, width_, *centre, minority_only);
         } else
 #endif
         {
@@ -444,8 +467,6 @@ public:
 
 private:
     std::ptrdiff_t width_;
-    std::int64_t off3_[16];
-    std::int64_t off4_[20];
 };
 
 }  // namespace evcorner
