@@ -33,19 +33,6 @@ struct ArcStarLatest {
     std::int64_t t[2];
 };
 
-/// The Arc* filter on stored values: `st` the event's stored time, `own` and `other` the
-/// pixel's latest stored times of the event's polarity and of the other one (0 = never).
-/// `zero_init`: the authors' zero-initialised state, where a pixel that never fired reads
-/// as time 0 rather than as never (so an event at t <= window there is rejected).
-[[nodiscard]] inline bool arcstar_filter_passes(std::int64_t st, std::int64_t own, std::int64_t other,
-                                                std::int64_t window, bool zero_init) noexcept {
-    const std::int64_t zero = zero_init ? Sae::kBias : 0;  // what a never-fired cell reads as
-    own = detail::select(own == 0, zero, own);
-    other = detail::select(other == 0, zero, other);
-    // Non-short-circuit: one branch-free test.
-    return (own == 0) | (st - own > window) | (other > own);
-}
-
 namespace detail {
 /// c ? a : b as a conditional move: the compiler turns some such choices into branches,
 /// and on the arc growth's data they mispredict.
@@ -60,6 +47,25 @@ inline T cmov(bool c, T a, T b) noexcept {
 #endif
 }
 }  // namespace detail
+
+/// The Arc* filter on stored values: `st` the event's stored time, `own` and `other` the
+/// pixel's latest stored times of the event's polarity and of the other one (0 = never).
+/// `zero_init`: the authors' zero-initialised state, where a pixel that never fired reads
+/// as time 0 rather than as never (so an event at t <= window there is rejected).
+[[nodiscard]] inline bool arcstar_filter_passes(std::int64_t st, std::int64_t own, std::int64_t other,
+                                                std::int64_t window, bool zero_init) noexcept {
+    const std::int64_t zero = zero_init ? Sae::kBias : 0;  // what a never-fired cell reads as
+    own = detail::cmov(own == 0, zero, own);  // conditional moves: 2 instructions, not 8
+    other = detail::cmov(other == 0, zero, other);
+    // Non-short-circuit: one branch-free test.
+    bool pass = (own == 0) | (st - own > window) | (other > own);
+#if defined(__GNUC__)
+    // Computed into a register here, so that the caller branches once on the outcome:
+    // GCC otherwise splits the conditions into two branches, each mispredicting alone.
+    __asm__("" : "+r"(pass));
+#endif
+    return pass;
+}
 
 /// Whether an Arc* arc of final `size` passes on a circle of N pixels.
 template <int N, int Lmin, int Lmax>
