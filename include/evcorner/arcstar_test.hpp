@@ -260,34 +260,42 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
 /// *separating* (its oldest strictly newer than every pixel outside it), or N if none.
 /// So the circle passes iff a separating arc has a length in Lmin..Lmax, or (unless
 /// minority_only) none has a length in Lmax+1..N-Lmax-1 and one has a length in
-/// N-Lmax..N-Lmin. Every length is tested for all arcs at once as eFAST's AVX-512 path
-/// does (sliding minima and maxima over the circle in vector registers), so there is no
-/// serial growth and no data-dependent branch. Only for code compiled for AVX-512.
+/// N-Lmax..N-Lmin. Every length is tested for all arcs at once, with the circle in vector
+/// registers (as eFAST's AVX-512 path, Avx512Search): lane s holds the oldest of the L
+/// pixels from s and the newest of the N-L pixels before s (the rest of that arc), both
+/// grown one pixel per length from rotated copies of the circle; one compare per length.
+/// No serial growth and no data-dependent branch. Only for code compiled for AVX-512.
 ///
 /// The circle is held as 32-bit times relative to the event's (order is all the test
 /// reads): 16 pixels fill one register instead of two. That is exact while every fired
 /// pixel of the circle lies within +-2^31 us (35 minutes) of the event; never-fired pixels
 /// become INT32_MIN, older than all of them. A circle outside that range (never on the
-/// real files) takes the same test on the 64-bit circles of Avx512Search.
+/// real files) takes the portable test (arcstar_circle_passes).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 struct ArcStarAvx512 {
-    // 16 pixels as 32-bit values in one register.
+    // Values per pixel of a 16-pixel circle: one register of 32-bit lanes.
+    struct Lanes16 {
+        __m512i v;
+    };
+    // The same for 20 pixels: lanes 0..19 of two registers (lanes 20..31 unused).
+    struct Lanes20 {
+        __m512i v[2];
+    };
+    // The 16-pixel circle; rot<J>() puts t[k + J] (mod 16) in lane k.
     struct Circle16 {
         __m512i v;
-        // t[k + J] (mod 16) in lane k.
         template <int J>
-        [[gnu::target(EVCORNER_AVX512_TARGET)]] Circle16 rot() const noexcept {
-            constexpr int j = J % 16;
-            if constexpr (j == 0) return *this;
-            else return {_mm512_alignr_epi32(v, v, j)};
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Lanes16 rot() const noexcept {
+            if constexpr (J % 16 == 0) return {v};
+            else return {_mm512_alignr_epi32(v, v, J % 16)};
         }
     };
-    // 20 pixels as 32-bit values extended periodically to 48 lanes (lane m: t[m mod 20]) in
-    // three registers, so that any 16 cyclically consecutive pixels are one valignd away.
+    // The 20-pixel circle extended periodically to 48 lanes (lane m: t[m mod 20]) in three
+    // registers, so that any 16 cyclically consecutive pixels are one valignd away.
     struct Circle20 {
         __m512i v[3];
         template <int A>
@@ -297,75 +305,59 @@ struct ArcStarAvx512 {
             else return _mm512_alignr_epi32(v[A / 16 + 1], v[A / 16], A % 16);
         }
         template <int J>
-        [[gnu::target(EVCORNER_AVX512_TARGET)]] Circle20 rot() const noexcept {
-            constexpr int j = J % 20;
-            return {{window<j>(), window<(16 + j) % 20>(), window<(32 + j) % 20>()}};
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Lanes20 rot() const noexcept {
+            return {{window<J % 20>(), window<(16 + J) % 20>()}};
         }
     };
 
-    // Lane by lane min or max, and the lanes (of the circle's N) where a > b, per circle type.
+    // Lane by lane min (Max = false) or max; the lanes (of the circle's N) where a > b.
     template <bool Max>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Circle16 lanes(const Circle16& a, const Circle16& b) noexcept {
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Lanes16 lanes(const Lanes16& a, const Lanes16& b) noexcept {
         return {Max ? _mm512_max_epi32(a.v, b.v) : _mm512_min_epi32(a.v, b.v)};
     }
     template <bool Max>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Circle20 lanes(const Circle20& a, const Circle20& b) noexcept {
-        Circle20 r;
-        for (int i = 0; i < 3; ++i) r.v[i] = Max ? _mm512_max_epi32(a.v[i], b.v[i]) : _mm512_min_epi32(a.v[i], b.v[i]);
-        return r;
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Lanes20 lanes(const Lanes20& a, const Lanes20& b) noexcept {
+        return {{Max ? _mm512_max_epi32(a.v[0], b.v[0]) : _mm512_min_epi32(a.v[0], b.v[0]),
+                 Max ? _mm512_max_epi32(a.v[1], b.v[1]) : _mm512_min_epi32(a.v[1], b.v[1])}};
     }
-    template <bool Max, class C>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static C lanes(const C& a, const C& b) noexcept {
-        return Avx512Search::lanes<Max>(a, b);  // the 64-bit circles
-    }
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Circle16& a, const Circle16& b) noexcept {
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Lanes16& a, const Lanes16& b) noexcept {
         return _mm512_cmpgt_epi32_mask(a.v, b.v);
     }
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Circle20& a, const Circle20& b) noexcept {
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Lanes20& a, const Lanes20& b) noexcept {
         return _kor_mask16(_mm512_cmpgt_epi32_mask(a.v[0], b.v[0]), _mm512_mask_cmpgt_epi32_mask(0xF, a.v[1], b.v[1]));
     }
-    template <class C>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const C& a, const C& b) noexcept {
-        return static_cast<__mmask16>(any_greater(a, b));  // the 64-bit circles
-    }
 
-    // The min (Max = false) or max of L pixels in lane s: t[s .. s+L-1] (Before = false) or
-    // t[s-L .. s-1] (Before = true). The rest of the arc of L pixels from s is the N-L pixels
-    // before s, so the oldest of every arc and the newest of every rest come out in the same
-    // lane, with no rotation per length. Built from a power-of-two window and the rest, as
-    // Avx512Search::sliding; shared sub-windows are computed once (the intrinsics are pure).
-    template <int N, int L, bool Max, bool Before, class C>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline C window(const C& t) noexcept {
-        if constexpr (L == 1) {
-            if constexpr (Before) return t.template rot<N - 1>();
-            else return t;
-        } else {
-            constexpr int h = (L & (L - 1)) == 0 ? L / 2 : 1 << (31 - __builtin_clz(static_cast<unsigned>(L)));
-            return lanes<Max>(window<N, h, Max, Before>(t),
-                              window<N, L - h, Max, Before>(t).template rot<Before ? N - h : h>());
-        }
+    // The oldest of t[s .. s+L-1] in lane s, one pixel more per length.
+    template <int N, int L, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto oldest_from(const C& t) noexcept {
+        if constexpr (L == 1) return t.template rot<0>();
+        else return lanes<false>(oldest_from<N, L - 1>(t), t.template rot<L - 1>());
+    }
+    // The newest of t[s-M .. s-1] in lane s: the rest of the arc of N-M pixels from s.
+    template <int N, int M, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto newest_before(const C& t) noexcept {
+        if constexpr (M == 1) return t.template rot<N - 1>();
+        else return lanes<true>(newest_before<N, M - 1>(t), t.template rot<N - M>());
     }
     // The lanes s where some arc of a length in L..Hi from s is separating (0 if L > Hi).
     // Mask registers throughout (kor): no round trip through general registers per length.
+    // (The recursions repeat sub-expressions; the intrinsics are pure, so the compiler
+    // computes each once.)
     template <int N, int L, int Hi, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __mmask16 separating(const C& t) noexcept {
         if constexpr (L > Hi) {
             return 0;
         } else {
-            const __mmask16 here = greater(window<N, L, false, false>(t), window<N, N - L, true, true>(t));
+            const __mmask16 here = greater(oldest_from<N, L>(t), newest_before<N, N - L>(t));
             if constexpr (L == Hi) return here;
             else return _kor_mask16(here, separating<N, L + 1, Hi>(t));
         }
     }
-    template <int N, int Lo, int Hi, class C>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool any_separating(const C& t) noexcept {
-        return separating<N, Lo, Hi>(t) != 0;
-    }
     template <int N, int Lmin, int Lmax, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool passes(const C& t, bool minority_only) noexcept {
-        const bool minority = any_separating<N, Lmin, Lmax>(t);
-        const bool between = any_separating<N, Lmax + 1, N - Lmax - 1>(t);
-        const bool majority = any_separating<N, N - Lmax, N - Lmin>(t);
+        const bool minority = separating<N, Lmin, Lmax>(t) != 0;
+        const bool between = separating<N, Lmax + 1, N - Lmax - 1>(t) != 0;
+        const bool majority = separating<N, N - Lmax, N - Lmin>(t) != 0;
         return minority | (!minority_only & !between & majority);
     }
 
@@ -409,12 +401,12 @@ struct ArcStarAvx512 {
         constexpr int N = 16, Lmin = 3, Lmax = 6;
         const __m256i q0 = quad<kCircle3, 0>(centre, w), q1 = quad<kCircle3, 4>(centre, w);
         const __m256i q2 = quad<kCircle3, 8>(centre, w), q3 = quad<kCircle3, 12>(centre, w);
-        const Avx512Search::Circle16 wide{{octet(q0, q1), octet(q2, q3)}};
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;
-        const __m256i lo = relative(wide.v[0], vst, inexact), hi = relative(wide.v[1], vst, inexact);
+        const __m256i lo = relative(octet(q0, q1), vst, inexact), hi = relative(octet(q2, q3), vst, inexact);
         if (inexact != 0) [[unlikely]]
-            return passes<N, Lmin, Lmax>(wide, minority_only);
+            return arcstar_circle_passes<N, Lmin, Lmax>(
+                centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only);
         return passes<N, Lmin, Lmax>(Circle16{octet(lo, hi)}, minority_only);
     }
     /// The radius-4 test, the same way.
@@ -425,14 +417,13 @@ struct ArcStarAvx512 {
         const __m256i q0 = quad<kCircle4, 0>(centre, w), q1 = quad<kCircle4, 4>(centre, w);
         const __m256i q2 = quad<kCircle4, 8>(centre, w), q3 = quad<kCircle4, 12>(centre, w);
         const __m256i q4 = quad<kCircle4, 16>(centre, w);
-        // t[0..8) t[8..16) t[16..20) t[0..4): Avx512Search::Circle20's first three vectors.
         const __m512i w0 = octet(q0, q1), w1 = octet(q2, q3), w2 = octet(q4, q0);
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;
         const __m256i a = relative(w0, vst, inexact), b = relative(w1, vst, inexact), c = relative(w2, vst, inexact);
         if (inexact != 0) [[unlikely]]
-            return passes<N, Lmin, Lmax>(Avx512Search::Circle20{{w0, w1, w2, _mm512_alignr_epi64(w1, w0, 4)}},
-                                         minority_only);
+            return arcstar_circle_passes<N, Lmin, Lmax>(
+                centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
         const __m512i v0 = octet(a, b);  // t[0..16)
         // t[16..20) into lanes 12..15, then t[16..20) t[0..12) and t[12..20) t[0..8).
         const __m512i c12 = _mm512_inserti32x4(v0, _mm256_castsi256_si128(c), 3);
