@@ -64,13 +64,10 @@ public:
     template <class Search>
     std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
         const View v = View::make(*this);
-        std::size_t corners = 0;
-        for (std::size_t i = 0; i < events.size(); ++i) {
-            const bool c = v.template process<Search>(events[i]);
-            is_corner[i] = static_cast<std::uint8_t>(c);
-            corners += c;
-        }
-        return corners;
+        // The published parameters (filter on, never-fired passes) as compile-time constants:
+        // the per-event filter then carries no tests of parameters.
+        if (params_.filter && !params_.zero_init) return v.template run<Search, true>(events, is_corner);
+        return v.template run<Search, false>(events, is_corner);
     }
 
     [[nodiscard]] const Params& params() const noexcept { return params_; }
@@ -110,13 +107,26 @@ private:
                     ArcStarCircles(d.sae_.size().width)};
         }
 
-        template <class Search>
+        template <class Search, bool Published>
+        std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
+            std::size_t corners = 0;
+            for (std::size_t i = 0; i < events.size(); ++i) {
+                const bool c = process<Search, Published>(events[i]);
+                is_corner[i] = static_cast<std::uint8_t>(c);
+                corners += c;
+            }
+            return corners;
+        }
+
+        // Published: the caller knows filter && !zero_init.
+        template <class Search, bool Published = false>
         bool process(const Event& e) const noexcept {
             const int p = e.p & 1;
             const std::ptrdiff_t i = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
             const std::int64_t st = Sae::stored(e.t);
             ArcStarLatest& l = latest[i];
-            const bool pass = !filter | arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, zero_init);
+            const bool pass = !(Published || filter) |
+                              arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, !Published && zero_init);
             l.t[p] = st;
             if (!pass) return false;
             std::int64_t* const centre = plane[p] + i;

@@ -54,9 +54,11 @@ inline T cmov(bool c, T a, T b) noexcept {
 /// as time 0 rather than as never (so an event at t <= window there is rejected).
 [[nodiscard]] inline bool arcstar_filter_passes(std::int64_t st, std::int64_t own, std::int64_t other,
                                                 std::int64_t window, bool zero_init) noexcept {
-    const std::int64_t zero = zero_init ? Sae::kBias : 0;  // what a never-fired cell reads as
-    own = detail::cmov(own == 0, zero, own);  // conditional moves: 2 instructions, not 8
-    other = detail::cmov(other == 0, zero, other);
+    if (zero_init) {  // a parameter (predicted; a constant where the caller knows it)
+        // A never-fired cell reads as time 0; conditional moves, not mask arithmetic.
+        own = detail::cmov(own == 0, Sae::kBias, own);
+        other = detail::cmov(other == 0, Sae::kBias, other);
+    }
     // Non-short-circuit: one branch-free test.
     bool pass = (own == 0) | (st - own > window) | (other > own);
 #if defined(__GNUC__)
