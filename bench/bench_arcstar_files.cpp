@@ -11,7 +11,8 @@
 // shared machine a run that is preempted is not charged for the other processes' turns;
 // EVCORNER_BENCH_WALL=1 times wall-clock (steady_clock) instead.
 // Usage: bench_arcstar_files [PASSES=21] [REPLAYS=10]
-// (EVCORNER_EFAST_PATH / EVCORNER_ARCSTAR_PATH=portable choose the code paths).
+// (EVCORNER_EFAST_PATH / EVCORNER_ARCSTAR_PATH=portable|avx2|avx512 choose the code paths;
+// FA-Harris follows EVCORNER_ARCSTAR_PATH).
 
 #include <algorithm>
 #include <chrono>
@@ -133,7 +134,7 @@ int main(int argc, char** argv) {
 
     std::printf("%s time; code paths: eFAST %s, Arc* %s; %d passes, %d replays\n",
                 std::getenv("EVCORNER_BENCH_WALL") ? "wall-clock" : "thread CPU", efast_code_path(),
-                std::getenv("EVCORNER_ARCSTAR_PATH") ? std::getenv("EVCORNER_ARCSTAR_PATH") : "default", passes, replays);
+                arcstar_code_path(), passes, replays);
     std::printf("%-20s | %8s %8s %9s %6s %6s | %8s %8s %9s %6s %6s\n", "ns/event (median)", "eFAST", "Arc*", "FA-Harris",
                 "A/eF", "FA/A", "eFAST", "Arc*", "FA-Harris", "A/eF", "FA/A");
     std::printf("%-20s | %42s | %42s\n", "", "cold (one pass per file)", "replayed");

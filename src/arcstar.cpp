@@ -1,6 +1,7 @@
-// Arc*: construction and the batch loop, compiled portable and for AVX2 (the newest-pixel
-// search of arc_test.hpp), chosen once at run time from the CPU's features. Both produce
-// identical flags; tests hold each to the oracle and the goldens.
+// Arc*: construction and the batch loop, compiled portable, for AVX2 (the newest-pixel
+// search of arc_test.hpp) and for AVX-512 (the closed form, ArcStarAvx512), chosen once at
+// run time from the CPU's features. All produce identical flags; tests hold each to the
+// oracle and the goldens.
 
 #include "evcorner/arcstar.hpp"
 
@@ -30,25 +31,40 @@ std::size_t detect_portable(ArcStar& det, std::span<const Event> events, std::sp
                                                                std::span<std::uint8_t> is_corner) noexcept {
     return det.run_unchecked<Avx2Search>(events, is_corner);
 }
+// Both circles by the closed form, all arcs at once (ArcStarAvx512 in arcstar_test.hpp).
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t detect_avx512(
+    ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    return det.run_unchecked<Avx512Search>(events, is_corner);
+}
 #endif
 
 using Loop = std::size_t (*)(ArcStar&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
 
-Loop choose() noexcept {
+struct Path {
+    const char* name;
+    Loop loop;
+};
+
+// The fastest path this CPU runs, or the one EVCORNER_ARCSTAR_PATH names if it runs it.
+Path choose() noexcept {
+    const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
+    const auto wanted = [forced](const char* name) { return forced == nullptr || std::strcmp(forced, name) == 0; };
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
     __builtin_cpu_init();
-    // EVCORNER_ARCSTAR_PATH=portable forces the portable loop on an AVX2 CPU.
-    const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
-    if (__builtin_cpu_supports("avx2") && !(forced != nullptr && std::strcmp(forced, "portable") == 0))
-        return detect_avx2;
+    if (wanted("avx512") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
+        return {"avx512", detect_avx512};
+    if ((wanted("avx2") || wanted("avx512")) && __builtin_cpu_supports("avx2")) return {"avx2", detect_avx2};
 #endif
-    return detect_portable;
+    return {"portable", detect_portable};
 }
 
-Loop loop() noexcept {
-    static const Loop l = choose();
-    return l;
+const Path& path() noexcept {
+    static const Path p = choose();
+    return p;
 }
+
+Loop loop() noexcept { return path().loop; }
 
 }  // namespace
 
@@ -62,6 +78,8 @@ std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::u
     check_events(events, det.limits());
     return loop()(det, events, is_corner);
 }
+
+const char* arcstar_code_path() noexcept { return path().name; }
 
 std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
     return loop()(det, events, is_corner);

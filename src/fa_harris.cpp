@@ -70,13 +70,10 @@ bool FaHarris::process_with(const Event& e) noexcept {
     *centre = st;
     arrival_[i] = ++arrivals_;
     newest_ = std::max(newest_, st);
-    // (3) The Arc* candidate test.
-    const std::ptrdiff_t w = static_cast<std::ptrdiff_t>(stride_);
-    const bool minority = params_.minority_only;
-    if (!arcstar_circle_passes<kCircle3.size(), ArcStar::kArc3Min, ArcStar::kArc3Max, Search>(
-            centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority) ||
-        !arcstar_circle_passes<kCircle4.size(), ArcStar::kArc4Min, ArcStar::kArc4Max, Search>(
-            centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority))
+    // (3) The Arc* candidate test (the AVX-512 path reads *centre as the event's time).
+    if (!ArcStarCircles(static_cast<std::ptrdiff_t>(stride_))
+             .pass<Search, ArcStar::kArc3Min, ArcStar::kArc3Max, ArcStar::kArc4Min, ArcStar::kArc4Max>(
+                 centre, params_.minority_only))
         return false;
     // (4) Harris on the nl newest filtered pixels of the window.
     score_ = refine(p, e.x, e.y);
@@ -177,17 +174,27 @@ std::size_t run_portable(FaHarris& det, std::span<const Event> events, std::span
                                                             std::span<std::uint8_t> is_corner) noexcept {
     return FaHarrisLoops::run<Avx2Search>(det, events, is_corner);
 }
+// The Arc* stage by its closed form, all arcs at once (ArcStarAvx512, arcstar_test.hpp).
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t run_avx512(
+    FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    return FaHarrisLoops::run<Avx512Search>(det, events, is_corner);
+}
 #endif
 
 using Loop = std::size_t (*)(FaHarris&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
 
+// The fastest loop this CPU runs, or the one EVCORNER_ARCSTAR_PATH names if it runs it (as
+// Arc*'s, arcstar.cpp).
 Loop loop() noexcept {
     static const Loop l = [] {
+        const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
+        const auto wanted = [forced](const char* name) { return forced == nullptr || std::strcmp(forced, name) == 0; };
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
         __builtin_cpu_init();
-        const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
-        if (__builtin_cpu_supports("avx2") && !(forced != nullptr && std::strcmp(forced, "portable") == 0))
-            return static_cast<Loop>(run_avx2);
+        if (wanted("avx512") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
+            return static_cast<Loop>(run_avx512);
+        if ((wanted("avx2") || wanted("avx512")) && __builtin_cpu_supports("avx2")) return static_cast<Loop>(run_avx2);
 #endif
         return static_cast<Loop>(run_portable);
     }();

@@ -111,5 +111,26 @@ TEST(ArcStarGoldenPaths, PortableLoopEqualsGolden) {
     EXPECT_EQ(positions(flags), test::read_index_file(test::shared_data() / "golden" / (f.prefix + ".arcstar.idx")));
 }
 
+// The AVX2 loop (detect() runs the AVX-512 one on a CPU that has it), every golden file.
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+[[gnu::target("avx2"), gnu::flatten]] void run_avx2(ArcStar& det, std::span<const Event> events,
+                                                    std::span<std::uint8_t> flags) {
+    det.run_unchecked<Avx2Search>(events, flags);
+}
+TEST(ArcStarGoldenPaths, Avx2LoopEqualsGolden) {
+    EVCORNER_REQUIRE_SHARED_DATA();
+    __builtin_cpu_init();
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU";
+    for (const GoldenFile& f : golden_files()) {
+        const auto events = f.load((test::shared_data() / f.events).string());
+        ArcStar det(kDavis240);
+        std::vector<std::uint8_t> flags(events.size());
+        run_avx2(det, events, flags);
+        EXPECT_EQ(positions(flags), test::read_index_file(test::shared_data() / "golden" / (f.prefix + ".arcstar.idx")))
+            << f.prefix;
+    }
+}
+#endif
+
 }  // namespace
 }  // namespace evcorner

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <random>
 #include <string>
@@ -51,6 +52,8 @@ void check_circles(std::uint64_t seed, int count, int (&sizes)[N + 1]) {
             if (c[k] > c[first_max]) first_max = k;
         ASSERT_EQ(newest, first_max);
         ASSERT_EQ((arcstar_arc_size<N, Lmin, Lmax>(t, newest)), expected) << "circle #" << i;
+        // The closed form (the AVX-512 path's definition) gives the same size.
+        ASSERT_EQ(naive::arcstar_size_by_separation<N>(c, Lmin), expected) << "circle #" << i;
         // The shortcut, when it speaks, is right.
         if (arcstar_surely_full<N, Lmin, Search>(t, newest)) {
             ASSERT_EQ(expected, N) << "circle #" << i;
@@ -84,6 +87,57 @@ TEST(ArcStarArc, Avx2PathEqualsTheDefinition) {
     if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU";
     int s16[17] = {}, s20[21] = {};
     check_avx2(s16, s20);
+}
+#endif
+
+// The AVX-512 path (closed form, all arcs at once) against the step-by-step definition.
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+template <int N, int Lmin, int Lmax>
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] void check_circles_avx512(std::uint64_t seed, int count,
+                                                                              int (&sizes)[N + 1]) {
+    std::mt19937_64 rng(seed);
+    for (int i = 0; i < count; ++i) {
+        const auto c = random_circle<N>(rng);
+        ++sizes[naive::arcstar_size_naive<N>(c, Lmin)];
+        // The circle drawn on a 9x9 grid (as a detector's plane holds it) around its centre.
+        constexpr std::ptrdiff_t kGrid = 9;
+        constexpr std::ptrdiff_t centre = 4 * kGrid + 4;
+        std::array<std::int64_t, kGrid * kGrid> grid{};
+        for (int k = 0; k < N; ++k) {
+            const Offset o = N == 16 ? kCircle3[k] : kCircle4[k];
+            grid[static_cast<std::size_t>(centre + o.dy * kGrid + o.dx)] = c[k];
+        }
+        // The event's stored time: just after the newest pixel (32-bit relative times), or
+        // far away (some or all fired pixels beyond +-2^31: the portable fallback).
+        std::int64_t newest = 0;
+        for (std::int64_t v : c) newest = std::max(newest, v);
+        const std::int64_t st_near = newest + static_cast<std::int64_t>(rng() % 1000);
+        const std::int64_t st_far = (std::int64_t{1} << 31) + static_cast<std::int64_t>(rng() % 2000000);
+        for (bool minority : {false, true}) {
+            const bool want = naive::arcstar_arc_naive<N>(c, Lmin, Lmax, minority);
+            bool near, far;
+            if constexpr (N == 16) {
+                near = ArcStarAvx512::circle16_passes(grid.data() + centre, kGrid, st_near, minority);
+                far = ArcStarAvx512::circle16_passes(grid.data() + centre, kGrid, st_far, minority);
+            } else {
+                near = ArcStarAvx512::circle20_passes(grid.data() + centre, kGrid, st_near, minority);
+                far = ArcStarAvx512::circle20_passes(grid.data() + centre, kGrid, st_far, minority);
+            }
+            ASSERT_EQ(near, want) << "circle #" << i;
+            ASSERT_EQ(far, want) << "circle #" << i;
+        }
+    }
+}
+TEST(ArcStarArc, Avx512PathEqualsTheDefinition) {
+    __builtin_cpu_init();
+    if (!(__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq")))
+        GTEST_SKIP() << "no AVX-512 on this CPU";
+    int s16[17] = {}, s20[21] = {};
+    check_circles_avx512<16, 3, 6>(5, 200000, s16);
+    check_circles_avx512<20, 4, 8>(6, 200000, s20);
+    for (int s = 3; s <= 16; ++s) EXPECT_GT(s16[s], 0) << "size " << s;
+    for (int s = 4; s <= 20; ++s) EXPECT_GT(s20[s], 0) << "size " << s;
 }
 #endif
 

@@ -259,29 +259,39 @@ struct Avx512Search {
         return any != 0;
     }
 
-    /// circle_fires<16, 3, 6> with the pixels at centre[offsets[k]].
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_fires(const std::int64_t* centre,
-                                                                           const std::int64_t* offsets) noexcept {
+    /// The 16-pixel circle with pixel k at centre[offsets[k]] (also Arc*'s, arcstar_test.hpp).
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline Circle16 load16(const std::int64_t* centre,
+                                                                       const std::int64_t* offsets) noexcept {
         // Loaded one by one into the vectors: two vpgatherqq were slower, and a copy
         // through memory stalls on store forwarding.
         const std::int64_t* o = offsets;
-        const Circle16 t{{_mm512_set_epi64(centre[o[7]], centre[o[6]], centre[o[5]], centre[o[4]], centre[o[3]],
-                                           centre[o[2]], centre[o[1]], centre[o[0]]),
-                          _mm512_set_epi64(centre[o[15]], centre[o[14]], centre[o[13]], centre[o[12]],
-                                           centre[o[11]], centre[o[10]], centre[o[9]], centre[o[8]])}};
-        return fires<16, 3, 6>(t);
+        return {{_mm512_set_epi64(centre[o[7]], centre[o[6]], centre[o[5]], centre[o[4]], centre[o[3]], centre[o[2]],
+                                  centre[o[1]], centre[o[0]]),
+                 _mm512_set_epi64(centre[o[15]], centre[o[14]], centre[o[13]], centre[o[12]], centre[o[11]],
+                                  centre[o[10]], centre[o[9]], centre[o[8]])}};
+    }
+
+    /// The 20-pixel circle with pixel k at centre[offsets[k]], extended to 32 lanes.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline Circle20 load20(const std::int64_t* centre,
+                                                                       const std::int64_t* offsets) noexcept {
+        std::int64_t p[20];
+        for (int k = 0; k < 20; ++k) p[k] = centre[offsets[k]];
+        return {{_mm512_set_epi64(p[7], p[6], p[5], p[4], p[3], p[2], p[1], p[0]),
+                 _mm512_set_epi64(p[15], p[14], p[13], p[12], p[11], p[10], p[9], p[8]),
+                 _mm512_set_epi64(p[3], p[2], p[1], p[0], p[19], p[18], p[17], p[16]),
+                 _mm512_set_epi64(p[11], p[10], p[9], p[8], p[7], p[6], p[5], p[4])}};
+    }
+
+    /// circle_fires<16, 3, 6> with the pixels at centre[offsets[k]].
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_fires(const std::int64_t* centre,
+                                                                           const std::int64_t* offsets) noexcept {
+        return fires<16, 3, 6>(load16(centre, offsets));
     }
 
     /// circle_fires<20, 4, 8> with the pixels at centre[offsets[k]].
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle20_fires(const std::int64_t* centre,
                                                                            const std::int64_t* offsets) noexcept {
-        std::int64_t p[20];
-        for (int k = 0; k < 20; ++k) p[k] = centre[offsets[k]];
-        const Circle20 t{{_mm512_set_epi64(p[7], p[6], p[5], p[4], p[3], p[2], p[1], p[0]),
-                          _mm512_set_epi64(p[15], p[14], p[13], p[12], p[11], p[10], p[9], p[8]),
-                          _mm512_set_epi64(p[3], p[2], p[1], p[0], p[19], p[18], p[17], p[16]),
-                          _mm512_set_epi64(p[11], p[10], p[9], p[8], p[7], p[6], p[5], p[4])}};
-        return fires<20, 4, 8>(t);
+        return fires<20, 4, 8>(load20(centre, offsets));
     }
 };
 #pragma GCC diagnostic pop

@@ -64,13 +64,10 @@ public:
     template <class Search>
     std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
         const View v = View::make(*this);
-        std::size_t corners = 0;
-        for (std::size_t i = 0; i < events.size(); ++i) {
-            const bool c = v.template process<Search>(events[i]);
-            is_corner[i] = static_cast<std::uint8_t>(c);
-            corners += c;
-        }
-        return corners;
+        // The published parameters (filter on, never-fired passes) as compile-time constants:
+        // the per-event filter then carries no tests of parameters.
+        if (params_.filter && !params_.zero_init) return v.template run<Search, true>(events, is_corner);
+        return v.template run<Search, false>(events, is_corner);
     }
 
     [[nodiscard]] const Params& params() const noexcept { return params_; }
@@ -96,19 +93,40 @@ private:
         int height;
         std::int64_t window;
         bool filter, minority_only, zero_init;
+        ArcStarCircles circles;
 
         static View make(ArcStar& d) noexcept {
-            return {{d.sae_.plane(0), d.sae_.plane(1)}, d.latest_.data(), d.sae_.size().width, d.sae_.size().height,
-                    d.params_.filter_us, d.params_.filter, d.params_.minority_only, d.params_.zero_init};
+            return {{d.sae_.plane(0), d.sae_.plane(1)},
+                    d.latest_.data(),
+                    d.sae_.size().width,
+                    d.sae_.size().height,
+                    d.params_.filter_us,
+                    d.params_.filter,
+                    d.params_.minority_only,
+                    d.params_.zero_init,
+                    ArcStarCircles(d.sae_.size().width)};
         }
 
-        template <class Search>
+        template <class Search, bool Published>
+        std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
+            std::size_t corners = 0;
+            for (std::size_t i = 0; i < events.size(); ++i) {
+                const bool c = process<Search, Published>(events[i]);
+                is_corner[i] = static_cast<std::uint8_t>(c);
+                corners += c;
+            }
+            return corners;
+        }
+
+        // Published: the caller knows filter && !zero_init.
+        template <class Search, bool Published = false>
         bool process(const Event& e) const noexcept {
             const int p = e.p & 1;
             const std::ptrdiff_t i = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
             const std::int64_t st = Sae::stored(e.t);
             ArcStarLatest& l = latest[i];
-            const bool pass = !filter | arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, zero_init);
+            const bool pass = !(Published || filter) |
+                              arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, !Published && zero_init);
             l.t[p] = st;
             if (!pass) return false;
             std::int64_t* const centre = plane[p] + i;
@@ -116,11 +134,7 @@ private:
             if (e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
                 e.y >= height - kCircleMargin)
                 return false;
-            const std::ptrdiff_t w = width;
-            return arcstar_circle_passes<kCircle3.size(), kArc3Min, kArc3Max, Search>(
-                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only) &&
-                   arcstar_circle_passes<kCircle4.size(), kArc4Min, kArc4Max, Search>(
-                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+            return circles.pass<Search, kArc3Min, kArc3Max, kArc4Min, kArc4Max>(centre, minority_only);
         }
     };
 
@@ -130,11 +144,14 @@ private:
 };
 static_assert(Detector<ArcStar>);
 
-/// detect() for Arc*: the same flags, with the fastest newest-pixel search this CPU runs
-/// (AVX2 where it has it, else portable), chosen once per process. Checks as the generic
+/// detect() for Arc*: the same flags, with the fastest code this CPU runs (AVX-512, else
+/// AVX2, else portable), chosen once per process; EVCORNER_ARCSTAR_PATH=portable|avx2|avx512
+/// forces one this CPU runs. Checks as the generic
 /// detect() does (InvalidEvent before any event is processed).
 std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
 /// detect() without the checks.
 std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+/// The code path detect() runs: "avx512", "avx2" or "portable".
+const char* arcstar_code_path() noexcept;
 
 }  // namespace evcorner

@@ -18,7 +18,11 @@
 
 #include <cstdint>
 
+#include <type_traits>
+#include <utility>
+
 #include "evcorner/arc_test.hpp"
+#include "evcorner/circle.hpp"
 #include "evcorner/sae.hpp"
 
 namespace evcorner {
@@ -28,19 +32,6 @@ namespace evcorner {
 struct ArcStarLatest {
     std::int64_t t[2];
 };
-
-/// The Arc* filter on stored values: `st` the event's stored time, `own` and `other` the
-/// pixel's latest stored times of the event's polarity and of the other one (0 = never).
-/// `zero_init`: the authors' zero-initialised state, where a pixel that never fired reads
-/// as time 0 rather than as never (so an event at t <= window there is rejected).
-[[nodiscard]] inline bool arcstar_filter_passes(std::int64_t st, std::int64_t own, std::int64_t other,
-                                                std::int64_t window, bool zero_init) noexcept {
-    const std::int64_t zero = zero_init ? Sae::kBias : 0;  // what a never-fired cell reads as
-    own = detail::select(own == 0, zero, own);
-    other = detail::select(other == 0, zero, other);
-    // Non-short-circuit: one branch-free test.
-    return (own == 0) | (st - own > window) | (other > own);
-}
 
 namespace detail {
 /// c ? a : b as a conditional move: the compiler turns some such choices into branches,
@@ -56,6 +47,27 @@ inline T cmov(bool c, T a, T b) noexcept {
 #endif
 }
 }  // namespace detail
+
+/// The Arc* filter on stored values: `st` the event's stored time, `own` and `other` the
+/// pixel's latest stored times of the event's polarity and of the other one (0 = never).
+/// `zero_init`: the authors' zero-initialised state, where a pixel that never fired reads
+/// as time 0 rather than as never (so an event at t <= window there is rejected).
+[[nodiscard]] inline bool arcstar_filter_passes(std::int64_t st, std::int64_t own, std::int64_t other,
+                                                std::int64_t window, bool zero_init) noexcept {
+    if (zero_init) {  // a parameter (predicted; a constant where the caller knows it)
+        // A never-fired cell reads as time 0; conditional moves, not mask arithmetic.
+        own = detail::cmov(own == 0, Sae::kBias, own);
+        other = detail::cmov(other == 0, Sae::kBias, other);
+    }
+    // Non-short-circuit: one branch-free test.
+    bool pass = (own == 0) | (st - own > window) | (other > own);
+#if defined(__GNUC__)
+    // Computed into a register here, so that the caller branches once on the outcome:
+    // GCC otherwise splits the conditions into two branches, each mispredicting alone.
+    __asm__("" : "+r"(pass));
+#endif
+    return pass;
+}
 
 /// Whether an Arc* arc of final `size` passes on a circle of N pixels.
 template <int N, int Lmin, int Lmax>
@@ -243,5 +255,217 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
     if (arcstar_surely_full<N, Lmin, Search>(t, newest)) return arcstar_size_passes<N, Lmin, Lmax>(N, minority_only);
     return arcstar_size_passes<N, Lmin, Lmax>(arcstar_arc_size<N, Lmin, Lmax>(t, newest), minority_only);
 }
+
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+/// Arc*'s arc test by its closed form (docs/arcstar.md, "The size in closed form"): the
+/// growth ends with size S = the smallest L >= Lmin for which some arc of L pixels is
+/// *separating* (its oldest strictly newer than every pixel outside it), or N if none.
+/// So the circle passes iff a separating arc has a length in Lmin..Lmax, or (unless
+/// minority_only) none has a length in Lmax+1..N-Lmax-1 and one has a length in
+/// N-Lmax..N-Lmin. Every length is tested for all arcs at once, with the circle in vector
+/// registers (as eFAST's AVX-512 path, Avx512Search): lane s holds the oldest of the L
+/// pixels from s and the newest of the N-L pixels before s (the rest of that arc), both
+/// grown one pixel per length from rotated copies of the circle; one compare per length.
+/// No serial growth and no data-dependent branch. Only for code compiled for AVX-512.
+///
+/// The circle is held as 32-bit times relative to the event's (order is all the test
+/// reads): 16 pixels fill one register instead of two. That is exact while every fired
+/// pixel of the circle lies within +-2^31 us (35 minutes) of the event; never-fired pixels
+/// become INT32_MIN, older than all of them. A circle outside that range (never on the
+/// real files) takes the portable test (arcstar_circle_passes).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+struct ArcStarAvx512 {
+    // Values per pixel of a 16-pixel circle: one register of 32-bit lanes.
+    struct Lanes16 {
+        __m512i v;
+    };
+    // The same for 20 pixels: lanes 0..19 of two registers (lanes 20..31 unused).
+    struct Lanes20 {
+        __m512i v[2];
+    };
+    // The 16-pixel circle; rot<J>() puts t[k + J] (mod 16) in lane k.
+    struct Circle16 {
+        __m512i v;
+        template <int J>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Lanes16 rot() const noexcept {
+            if constexpr (J % 16 == 0) return {v};
+            else return {_mm512_alignr_epi32(v, v, J % 16)};
+        }
+    };
+    // The 20-pixel circle extended periodically to 48 lanes (lane m: t[m mod 20]) in three
+    // registers, so that any 16 cyclically consecutive pixels are one valignd away.
+    struct Circle20 {
+        __m512i v[3];
+        template <int A>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] __m512i window() const noexcept {
+            static_assert(A < 32);
+            if constexpr (A % 16 == 0) return v[A / 16];
+            else return _mm512_alignr_epi32(v[A / 16 + 1], v[A / 16], A % 16);
+        }
+        template <int J>
+        [[gnu::target(EVCORNER_AVX512_TARGET)]] Lanes20 rot() const noexcept {
+            return {{window<J % 20>(), window<(16 + J) % 20>()}};
+        }
+    };
+
+    // Lane by lane min (Max = false) or max; the lanes (of the circle's N) where a > b.
+    template <bool Max>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Lanes16 lanes(const Lanes16& a, const Lanes16& b) noexcept {
+        return {Max ? _mm512_max_epi32(a.v, b.v) : _mm512_min_epi32(a.v, b.v)};
+    }
+    template <bool Max>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Lanes20 lanes(const Lanes20& a, const Lanes20& b) noexcept {
+        return {{Max ? _mm512_max_epi32(a.v[0], b.v[0]) : _mm512_min_epi32(a.v[0], b.v[0]),
+                 Max ? _mm512_max_epi32(a.v[1], b.v[1]) : _mm512_min_epi32(a.v[1], b.v[1])}};
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Lanes16& a, const Lanes16& b) noexcept {
+        return _mm512_cmpgt_epi32_mask(a.v, b.v);
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static __mmask16 greater(const Lanes20& a, const Lanes20& b) noexcept {
+        return _kor_mask16(_mm512_cmpgt_epi32_mask(a.v[0], b.v[0]), _mm512_mask_cmpgt_epi32_mask(0xF, a.v[1], b.v[1]));
+    }
+
+    // The oldest of t[s .. s+L-1] in lane s, one pixel more per length.
+    template <int N, int L, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto oldest_from(const C& t) noexcept {
+        if constexpr (L == 1) return t.template rot<0>();
+        else return lanes<false>(oldest_from<N, L - 1>(t), t.template rot<L - 1>());
+    }
+    // The newest of t[s-M .. s-1] in lane s: the rest of the arc of N-M pixels from s.
+    template <int N, int M, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto newest_before(const C& t) noexcept {
+        if constexpr (M == 1) return t.template rot<N - 1>();
+        else return lanes<true>(newest_before<N, M - 1>(t), t.template rot<N - M>());
+    }
+    // The lanes s where some arc of a length in L..Hi from s is separating (0 if L > Hi).
+    // Mask registers throughout (kor): no round trip through general registers per length.
+    // (The recursions repeat sub-expressions; the intrinsics are pure, so the compiler
+    // computes each once.)
+    template <int N, int L, int Hi, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __mmask16 separating(const C& t) noexcept {
+        if constexpr (L > Hi) {
+            return 0;
+        } else {
+            const __mmask16 here = greater(oldest_from<N, L>(t), newest_before<N, N - L>(t));
+            if constexpr (L == Hi) return here;
+            else return _kor_mask16(here, separating<N, L + 1, Hi>(t));
+        }
+    }
+    template <int N, int Lmin, int Lmax, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool passes(const C& t, bool minority_only) noexcept {
+        const bool minority = separating<N, Lmin, Lmax>(t) != 0;
+        const bool between = separating<N, Lmax + 1, N - Lmax - 1>(t) != 0;
+        const bool majority = separating<N, N - Lmax, N - Lmin>(t) != 0;
+        return minority | (!minority_only & !between & majority);
+    }
+
+    // 8 stored times as 32-bit times relative to `st`, and the lanes where that is not
+    // exact (a fired pixel more than 2^31 - 1 us away): saturating narrowing, so a
+    // never-fired pixel (stored 0) becomes INT32_MIN.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i relative(__m512i q, __m512i st,
+                                                                        __mmask8& inexact) noexcept {
+        const __m512i d = _mm512_sub_epi64(q, st);
+        // d within [INT32_MIN + 1, INT32_MAX]  <=>  unsigned(d - (INT32_MIN + 1)) <= 2^32 - 2
+        const __m512i u = _mm512_sub_epi64(d, _mm512_set1_epi64(std::int64_t{INT32_MIN} + 1));
+        inexact |= _mm512_mask_cmpgt_epu64_mask(_mm512_test_epi64_mask(q, q), u,
+                                                _mm512_set1_epi64((std::int64_t{1} << 32) - 2));
+        return _mm512_cvtsepi64_epi32(d);
+    }
+
+    // Pixels K..K+3 of a circle (array of Offset) around `centre` in a row of width `w`, as
+    // 64-bit lanes. Each address is centre + dy * w + dx with dy, dx constants, so the loads
+    // need no offset table (which the loop would keep on the stack), and each goes straight
+    // into a vector register (vmovq / vpinsrq from memory).
+    template <const auto& Circle, int K>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i quad(const std::int64_t* centre,
+                                                                     std::ptrdiff_t w) noexcept {
+        const auto pair = [centre, w](int k) {
+            return std::pair{centre + Circle[k].dy * w + Circle[k].dx, centre + Circle[k + 1].dy * w + Circle[k + 1].dx};
+        };
+        const auto [a, b] = pair(K);
+        const auto [c, d] = pair(K + 2);
+        const __m128i lo = _mm_insert_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a)), *b, 1);
+        const __m128i hi = _mm_insert_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(c)), *d, 1);
+        return _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m512i octet(__m256i lo, __m256i hi) noexcept {
+        return _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1);
+    }
+
+    /// The radius-3 test around `centre` (rows `w` cells wide) for an event of stored time st.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_passes(const std::int64_t* centre,
+                                                                            std::ptrdiff_t w, std::int64_t st,
+                                                                            bool minority_only) noexcept {
+        constexpr int N = 16, Lmin = 3, Lmax = 6;
+        const __m256i q0 = quad<kCircle3, 0>(centre, w), q1 = quad<kCircle3, 4>(centre, w);
+        const __m256i q2 = quad<kCircle3, 8>(centre, w), q3 = quad<kCircle3, 12>(centre, w);
+        const __m512i vst = _mm512_set1_epi64(st);
+        __mmask8 inexact = 0;
+        const __m256i lo = relative(octet(q0, q1), vst, inexact), hi = relative(octet(q2, q3), vst, inexact);
+        if (inexact != 0) [[unlikely]]
+            return arcstar_circle_passes<N, Lmin, Lmax>(
+                centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only);
+        return passes<N, Lmin, Lmax>(Circle16{octet(lo, hi)}, minority_only);
+    }
+    /// The radius-4 test, the same way.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle20_passes(const std::int64_t* centre,
+                                                                            std::ptrdiff_t w, std::int64_t st,
+                                                                            bool minority_only) noexcept {
+        constexpr int N = 20, Lmin = 4, Lmax = 8;
+        const __m256i q0 = quad<kCircle4, 0>(centre, w), q1 = quad<kCircle4, 4>(centre, w);
+        const __m256i q2 = quad<kCircle4, 8>(centre, w), q3 = quad<kCircle4, 12>(centre, w);
+        const __m256i q4 = quad<kCircle4, 16>(centre, w);
+        const __m512i w0 = octet(q0, q1), w1 = octet(q2, q3), w2 = octet(q4, q0);
+        const __m512i vst = _mm512_set1_epi64(st);
+        __mmask8 inexact = 0;
+        const __m256i a = relative(w0, vst, inexact), b = relative(w1, vst, inexact), c = relative(w2, vst, inexact);
+        if (inexact != 0) [[unlikely]]
+            return arcstar_circle_passes<N, Lmin, Lmax>(
+                centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+        const __m512i v0 = octet(a, b);  // t[0..16)
+        // t[16..20) into lanes 12..15, then t[16..20) t[0..12) and t[12..20) t[0..8).
+        const __m512i c12 = _mm512_inserti32x4(v0, _mm256_castsi256_si128(c), 3);
+        const __m512i v1 = _mm512_alignr_epi32(v0, c12, 12);
+        const __m512i v2 = _mm512_alignr_epi32(v1, v0, 12);
+        return passes<N, Lmin, Lmax>(Circle20{{v0, v1, v2}}, minority_only);
+    }
+};
+#pragma GCC diagnostic pop
+#endif
+
+/// Both Arc* circles around a pixel of an SAE plane `width` cells wide: the radius-3
+/// test, then (only if it passed) the radius-4 one. Shared by ArcStar and FA-Harris.
+class ArcStarCircles {
+public:
+    explicit ArcStarCircles(std::ptrdiff_t width) noexcept : width_(width) {}
+
+    /// `centre` holds the event's own stored time (the caller has just written it).
+    template <class Search, int Lmin3, int Lmax3, int Lmin4, int Lmax4>
+    [[nodiscard]] bool pass(const std::int64_t* centre, bool minority_only) const noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        if constexpr (std::is_same_v<Search, Avx512Search>) {
+            static_assert(Lmin3 == 3 && Lmax3 == 6 && Lmin4 == 4 && Lmax4 == 8);
+            return ArcStarAvx512::circle16_passes(centre, width_, *centre, minority_only) &&
+                   ArcStarAvx512::circle20_passes(centre, width_, *centre, minority_only);
+        } else
+#endif
+        {
+            // Offsets from compile-time circle coordinates: rows centre + dy * width with
+            // constant column offsets.
+            const std::ptrdiff_t w = width_;
+            return arcstar_circle_passes<kCircle3.size(), Lmin3, Lmax3, Search>(
+                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only) &&
+                   arcstar_circle_passes<kCircle4.size(), Lmin4, Lmax4, Search>(
+                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+        }
+    }
+
+private:
+    std::ptrdiff_t width_;
+};
 
 }  // namespace evcorner

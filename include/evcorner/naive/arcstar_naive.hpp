@@ -4,6 +4,7 @@
 // with INT64_MIN for never fired, the filter as three plain conditions, the arc growth
 // with modulo indices and ifs. Slow and simple on purpose.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -57,6 +58,22 @@ int arcstar_size_naive(const std::array<std::int64_t, N>& T, int lmin) {
         }
     }
     return size;
+}
+
+/// The same size by its closed form (docs/arcstar.md, "The size in closed form"): the
+/// smallest L in lmin..N-1 for which some arc of L pixels is separating (its oldest strictly
+/// newer than every pixel outside it), or N if none. Tests hold it to arcstar_size_naive().
+template <int N>
+int arcstar_size_by_separation(const std::array<std::int64_t, N>& T, int lmin) {
+    for (int len = lmin; len < N; ++len) {
+        for (int start = 0; start < N; ++start) {
+            std::int64_t oldest_in = INT64_MAX, newest_out = INT64_MIN;
+            for (int i = 0; i < len; ++i) oldest_in = std::min(oldest_in, T[(start + i) % N]);
+            for (int i = len; i < N; ++i) newest_out = std::max(newest_out, T[(start + i) % N]);
+            if (oldest_in > newest_out) return len;
+        }
+    }
+    return N;
 }
 
 /// The Arc* arc test on one circle: the size within lmin..lmax, or (unless
