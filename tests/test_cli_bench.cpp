@@ -94,6 +94,20 @@ TEST_F(CliBench, YardstickIsAPlainEfastTimedInTheSameRun) {
     EXPECT_EQ(j["results"][0]["yardstick_ns_per_event_median"], j["results"][1]["yardstick_ns_per_event_median"]);
 }
 
+TEST_F(CliBench, CpuTimeClock) {
+    const Result r = run("bench '" + sample_.string() + "' -d efast --min-events 1 --repeat 1 --no-latency "
+                         "--cpu-time --json b.json -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("thread CPU time"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "b.json"));
+    EXPECT_EQ(j["clock"], "thread CPU time");
+    EXPECT_GT(j["results"][0]["cold_ns_per_event_median"].get<double>(), 0.0);
+    // One thread's CPU time cannot time a split over several.
+    const Result bad = run("bench '" + sample_.string() + "' -d efast --min-events 1 --cpu-time --threads 1,2 -q");
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_NE(bad.err.find("--cpu-time"), std::string::npos) << bad.err;
+}
+
 TEST_F(CliBench, UnknownDetectorIsAUsageError) {
     const Result r = run("bench '" + sample_.string() + "' -d nope --min-events 10");
     EXPECT_EQ(r.status, 2);

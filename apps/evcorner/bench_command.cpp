@@ -16,6 +16,8 @@
 //    section (the clock's own overhead) is measured first and subtracted; it is printed.
 //    The timed pass runs slower than the throughput passes (the fences stop events from
 //    overlapping), so its percentiles bound a single event's latency from above.
+//  - --cpu-time: passes timed by the thread's CPU time instead of steady_clock (for a shared
+//    machine: it leaves out the time other processes hold the core).
 //  - --threads 1,2,...: the local detectors (the registry says which) also run split over
 //    that many threads (parallel_detect.hpp), timed the same way; thread start-up is
 //    outside the timing.
@@ -79,6 +81,7 @@ struct BenchOptions {
     std::string threads = "1";
     bool no_latency = false;
     bool yardstick = false;
+    bool cpu_time = false;
     bool quiet = false;
     bool no_progress = false;
 };
@@ -256,7 +259,7 @@ using PassDone = std::function<void(std::uint64_t events)>;
 
 template <class Pass>
 Row timed_passes(const std::string& input, const std::string& name, int threads, SensorSize sensor,
-                 const std::vector<Event>& events, std::uint64_t file_events, int repeat, Pass pass,
+                 const std::vector<Event>& events, std::uint64_t file_events, int repeat, bool cpu_time, Pass pass,
                  const PassDone& done) {
     Row row;
     row.input = input;
@@ -269,9 +272,9 @@ Row timed_passes(const std::string& input, const std::string& name, int threads,
     const double n = static_cast<double>(events.size());
     for (int r = 0; r < repeat; ++r) {
         pass(row, flags, [&](auto&& run) {
-            const auto t0 = Clock::now();
+            const double t0 = bench_clock_ns(cpu_time);
             run();
-            row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / n);
+            row.ns_per_event.push_back((bench_clock_ns(cpu_time) - t0) / n);
         });
         done(events.size());
     }
@@ -284,7 +287,7 @@ Row timed_passes(const std::string& input, const std::string& name, int threads,
 Row bench_one(const std::string& input, const std::string& name, SensorSize sensor,
               const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
               Latency& clock, const PassDone& done) {
-    Row row = timed_passes(input, name, 1, sensor, events, file_events, o.repeat,
+    Row row = timed_passes(input, name, 1, sensor, events, file_events, o.repeat, o.cpu_time,
                            [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
                                AnyDetector any = make_detector(config_for(name, o.detector_params), sensor, "--");
                                r.memory = memory_bytes(any);
@@ -322,7 +325,7 @@ ColdRuns cold_runs(const std::vector<Event>& file, SensorSize sensor, const std:
     const double n = static_cast<double>(file.size());
     for (int r = 0; r < o.repeat; ++r) {
         if (o.yardstick) {
-            const YardstickPass y = plain_efast_pass(std::span<const Event>(file), sensor);
+            const YardstickPass y = plain_efast_pass(std::span<const Event>(file), sensor, o.cpu_time);
             cold.yardstick_ns.push_back(y.ns_per_event);
             cold.yardstick_corners = y.corners;
             done(file.size());
@@ -331,9 +334,9 @@ ColdRuns cold_runs(const std::vector<Event>& file, SensorSize sensor, const std:
             AnyDetector any = make_detector(config_for(detectors[d], o.detector_params), sensor, "--");
             std::visit(
                 [&](auto& det) {
-                    const auto t0 = Clock::now();
+                    const double t0 = bench_clock_ns(o.cpu_time);
                     cold.corners[d] = detect(det, std::span<const Event>(file), flags);
-                    cold.ns[d].push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / n);
+                    cold.ns[d].push_back((bench_clock_ns(o.cpu_time) - t0) / n);
                 },
                 any);
             done(file.size());
@@ -347,7 +350,7 @@ Row bench_parallel(const std::string& input, const std::string& name, int thread
                    const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
                    const PassDone& done) {
     auto passes = [&](auto make_par) {
-        return timed_passes(input, name, threads, sensor, events, file_events, o.repeat,
+        return timed_passes(input, name, threads, sensor, events, file_events, o.repeat, o.cpu_time,
                             [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
                                 auto par = make_par();  // threads started outside the timing
                                 time([&] { r.corners = par->detect(std::span<const Event>(events), flags); });
@@ -461,6 +464,7 @@ void write_json(const std::string& path, const std::vector<Row>& rows, const std
     j["build_flags"] = EVCORNER_BUILD_FLAGS;
     j["efast_code_path"] = efast_code_path();
     j["repeat"] = o.repeat;
+    j["clock"] = o.cpu_time ? "thread CPU time" : "steady_clock";
     j["yardstick"] = o.yardstick ? nlohmann::json("built-in plain exhaustive eFAST (bench_command_yardstick.cpp), "
                                                   "same compiler and flags")
                                  : nlohmann::json(nullptr);
@@ -536,6 +540,8 @@ void run_bench(const BenchOptions& o) {
         thread_counts.push_back(k);
     }
     if (thread_counts.empty()) thread_counts.push_back(1);
+    if (o.cpu_time && std::any_of(thread_counts.begin(), thread_counts.end(), [](int k) { return k > 1; }))
+        throw std::invalid_argument("--cpu-time: one thread's CPU time does not time several threads; use --threads 1");
 
     const std::string cpu = cpu_model();
     fmt::print(out, "evcorner bench: {} input(s), detectors {}, {} pass(es) each over >= {} events\n",
@@ -543,9 +549,12 @@ void run_bench(const BenchOptions& o) {
     fmt::print(out, "CPU      {}\n", cpu);
     fmt::print(out, "build    {} build, {}, flags: {}; eFAST code path: {}\n", EVCORNER_BUILD_TYPE, compiler(),
                EVCORNER_BUILD_FLAGS, efast_code_path());
-    fmt::print(out, "method   one thread; throughput: steady_clock around detect() over the replayed stream,\n"
-               "         fresh detector per pass; latency: rdtscp/lfence around each event, clock overhead\n"
-               "         subtracted (fenced, so an upper bound)\n\n");
+    fmt::print(out, "method   one thread; throughput: {} around detect() over the replayed stream,\n",
+               o.cpu_time ? "thread CPU time" : "steady_clock");
+    fmt::print(out, "         fresh detector per pass; cold: the same over each file once (no replay){};\n"
+               "         latency: rdtscp/lfence around each event, clock overhead\n"
+               "         subtracted (fenced, so an upper bound)\n\n",
+               o.yardstick ? ", beside the yardstick (a built-in plain eFAST)" : "");
     flush_checked(out);
 
     // The progress bar counts passes: per input, each detector and thread count runs
@@ -660,6 +669,10 @@ void add_bench_command(CLI::App& app) {
                   "Also time the yardstick, a plain exhaustive eFAST built into the tool (same compiler and "
                   "flags; the computation of ../shared/tools/plain-efast.cpp), cold on each input in the same "
                   "rounds, and report each detector's cold speed as a multiple of it (x yard)");
+    cmd->add_flag("--cpu-time", o->cpu_time,
+                  "Time the throughput and cold passes (and the yardstick) by the thread's CPU time instead of "
+                  "the wall clock: on a shared machine it leaves out the time other processes hold the core "
+                  "(not what they do to the caches)");
     cmd->add_flag("-q,--quiet", o->quiet, "No per-run progress lines and no progress bar on standard error");
     cmd->add_flag("--no-progress", o->no_progress, "No progress bar (it shows only on a terminal)");
     cmd->footer(

@@ -14,12 +14,17 @@
 
 namespace evcorner::cli {
 
+/// Now in ns for timing a pass: the wall clock (steady_clock), or with `cpu_time` the calling
+/// thread's CPU time (CLOCK_THREAD_CPUTIME_ID), which leaves out the time other processes
+/// hold the core on a loaded machine.
+double bench_clock_ns(bool cpu_time) noexcept;
+
 struct YardstickPass {
     std::uint64_t corners = 0;
-    double ns_per_event = 0;  ///< steady_clock around the event loop (state allocation outside)
+    double ns_per_event = 0;  ///< bench_clock_ns around the event loop (state allocation outside)
 };
 
 /// One cold pass of the plain eFAST over `events` (a fresh, never-fired SAE).
-YardstickPass plain_efast_pass(std::span<const Event> events, SensorSize sensor);
+YardstickPass plain_efast_pass(std::span<const Event> events, SensorSize sensor, bool cpu_time);
 
 }  // namespace evcorner::cli
