@@ -34,6 +34,60 @@ HarrisScorer::HarrisScorer(int window, double k) : window_(window), k_(k) {
         smooth5_[bits] = static_cast<std::int8_t>(s);
         deriv5_[bits] = static_cast<std::int8_t>(d);
     }
+    for (unsigned bits = 0; bits < 512; ++bits)
+        for (unsigned c = 0; c < 5; ++c) {
+            const unsigned run = bits >> c & 31u;
+            smooth9_[bits] |= static_cast<std::uint64_t>(smooth5_[run]) << (12 * c);
+            deriv9_[bits] |= static_cast<std::uint64_t>(deriv5_[run] + 3) << (12 * c);
+        }
+    if (window == 9) {
+        constexpr int kD2[6] = {0, 1, 2, 4, 5, 8};
+        for (int i = 0; i < 6; ++i)
+            for (int r = 0; r < 5; ++r)
+                for (int c = 0; c < 5; ++c)
+                    if ((r - 2) * (r - 2) + (c - 2) * (c - 2) == kD2[i]) h9_[i] = h_[r * 5 + c];
+    }
+}
+
+double HarrisScorer::score9(const std::uint16_t* rows) const noexcept {
+    // Field c of a word holds column c of a gradient row; 12-bit fields never carry: every
+    // field stays within 0..96 (the gradients 12*I lie within -48..48, biased by +48).
+    constexpr std::uint64_t kField = 0xFFF;
+    constexpr std::uint64_t kOnes = 0x0001'0010'0100'1001ull;  // 1 in each of the 5 fields
+    std::uint64_t sm[9], de[9];
+    for (int r = 0; r < 9; ++r) {
+        sm[r] = smooth9_[rows[r] & 511u];
+        de[r] = deriv9_[rows[r] & 511u];
+    }
+    // Squared distance class of (|row - 2|, |column - 2|) -> index into h9_.
+    constexpr int kClass[3][3] = {{0, 1, 3}, {1, 2, 4}, {3, 4, 5}};
+    std::int64_t sa[6] = {}, sb[6] = {}, sc[6] = {};
+    for (int r = 0; r < 5; ++r) {
+        // 12 Ix = smooth along y of the derivative runs; 12 Iy = derivative along y of the
+        // smooth runs; both + 48 per field (deriv9_ holds the runs + 3, the taps sum to 16).
+        const std::uint64_t x = de[r] + 4 * de[r + 1] + 6 * de[r + 2] + 4 * de[r + 3] + de[r + 4];
+        const std::uint64_t y = (sm[r] + 2 * sm[r + 1] + 48 * kOnes) - (2 * sm[r + 3] + sm[r + 4]);
+        const int ar = r < 2 ? 2 - r : r - 2;
+        for (int c = 0; c < 5; ++c) {
+            const auto ix = static_cast<std::int64_t>(x >> (12 * c) & kField) - 48;
+            const auto iy = static_cast<std::int64_t>(y >> (12 * c) & kField) - 48;
+            const int k = kClass[ar][c < 2 ? 2 - c : c - 2];
+            sa[k] += ix * ix;
+            sb[k] += ix * iy;
+            sc[k] += iy * iy;
+        }
+    }
+    double a = 0, b = 0, cc = 0;
+    for (int k = 0; k < 6; ++k) {
+        a += h9_[k] * static_cast<double>(sa[k]);
+        b += h9_[k] * static_cast<double>(sb[k]);
+        cc += h9_[k] * static_cast<double>(sc[k]);
+    }
+    constexpr double kScale2 = kHarrisKernelScale * kHarrisKernelScale;
+    a /= kScale2;
+    b /= kScale2;
+    cc /= kScale2;
+    return a * cc - b * b - k_ * (a + cc) * (a + cc);
 }
 
 template <int W>
@@ -74,7 +128,7 @@ double HarrisScorer::score(const std::uint16_t* rows) const noexcept {
     switch (window_) {
         case 5: return score_fixed<5>(rows);
         case 7: return score_fixed<7>(rows);
-        case 9: return score_fixed<9>(rows);
+        case 9: return score9(rows);
         case 11: return score_fixed<11>(rows);
         case 13: return score_fixed<13>(rows);
         default: return score_fixed<15>(rows);

@@ -46,6 +46,68 @@ TEST_F(CliBench, PrintsTheTableAndWritesJson) {
     EXPECT_EQ(j["results"][0]["corners"], j["results"][1]["corners"]);
 }
 
+TEST_F(CliBench, ReportsColdAndReplayedFigures) {
+    // The sample has 30 000 events; replayed to 70 000 the stream holds three copies.
+    const Result r = run("bench '" + sample_.string() + "' -d efast,harris --min-events 70000 --repeat 2 "
+                         "--no-latency --json b.json -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const char* what : {"cold", "cold/rep", "replayed ns/event"})
+        EXPECT_NE(r.out.find(what), std::string::npos) << what << " missing from:\n" << r.out;
+    EXPECT_EQ(r.out.find("x yard"), std::string::npos) << "no yardstick column unless asked:\n" << r.out;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "b.json"));
+    EXPECT_TRUE(j["yardstick"].is_null());
+    ASSERT_EQ(j["results"].size(), 2u);
+    for (const auto& x : j["results"]) {
+        const auto file_events = x["file_events"].get<std::uint64_t>();
+        EXPECT_EQ(x["cold_events"].get<std::uint64_t>(), file_events);
+        EXPECT_GT(x["events"].get<std::uint64_t>(), 2 * file_events);  // replayed
+        EXPECT_EQ(x["cold_ns_per_event"].size(), 2u);
+        EXPECT_GT(x["cold_ns_per_event_median"].get<double>(), 0.0);
+        EXPECT_GT(x["cold_vs_replayed"].get<double>(), 0.0);
+        EXPECT_FALSE(x.contains("yardstick_ratio"));
+        // One pass over the file finds fewer corners than three replayed copies, and some.
+        EXPECT_GT(x["cold_corners"].get<std::uint64_t>(), 0u);
+        EXPECT_LT(x["cold_corners"].get<std::uint64_t>(), x["corners"].get<std::uint64_t>());
+    }
+}
+
+TEST_F(CliBench, YardstickIsAPlainEfastTimedInTheSameRun) {
+    const Result r = run("bench '" + sample_.string() + "' -d efast,harris --min-events 1 --repeat 2 "
+                         "--no-latency --yardstick --json b.json -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("x yard"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "b.json"));
+    ASSERT_TRUE(j["yardstick"].is_string());
+    ASSERT_EQ(j["results"].size(), 2u);
+    const auto& efast = j["results"][0];
+    ASSERT_EQ(efast["detector"], "efast");
+    // The yardstick computes eFAST: on the file it finds exactly eFAST's corners.
+    EXPECT_EQ(efast["yardstick_corners"].get<std::uint64_t>(), efast["cold_corners"].get<std::uint64_t>());
+    EXPECT_GT(efast["yardstick_corners"].get<std::uint64_t>(), 0u);
+    for (const auto& x : j["results"]) {
+        const double yard = x["yardstick_ns_per_event_median"].get<double>();
+        const double cold = x["cold_ns_per_event_median"].get<double>();
+        EXPECT_GT(yard, 0.0);
+        EXPECT_DOUBLE_EQ(x["yardstick_ratio"].get<double>(), yard / cold);
+    }
+    // The same yardstick figure for every detector of an input.
+    EXPECT_EQ(j["results"][0]["yardstick_ns_per_event_median"], j["results"][1]["yardstick_ns_per_event_median"]);
+}
+
+TEST_F(CliBench, CpuTimeClock) {
+    const Result r = run("bench '" + sample_.string() + "' -d efast --min-events 1 --repeat 1 --no-latency "
+                         "--cpu-time --json b.json -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("thread CPU time"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "b.json"));
+    EXPECT_EQ(j["clock"], "thread CPU time");
+    EXPECT_GT(j["results"][0]["cold_ns_per_event_median"].get<double>(), 0.0);
+    // One thread's CPU time cannot time a split over several.
+    const Result bad = run("bench '" + sample_.string() + "' -d efast --min-events 1 --cpu-time --threads 1,2 -q");
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_NE(bad.err.find("--cpu-time"), std::string::npos) << bad.err;
+}
+
 TEST_F(CliBench, UnknownDetectorIsAUsageError) {
     const Result r = run("bench '" + sample_.string() + "' -d nope --min-events 10");
     EXPECT_EQ(r.status, 2);

@@ -1,9 +1,12 @@
 // evcorner bench: the paper's Table 2 (time per event, maximum event rate) for this
 // machine, on any input, rerunnable by anyone.
 //
-// Method. Each input is read into memory once, then replayed back to back until the
-// stream holds at least --min-events events; repetition r is shifted by r x (span + 1 us)
-// so that time keeps increasing. Per detector:
+// Method. Each input is read into memory once. Per input, first the cold figures: --repeat
+// rounds, in each the yardstick (with --yardstick) and then every detector run once over the
+// file as it is (one pass, a freshly built detector, construction not timed), timed with
+// steady_clock around detect() alone: what a user running files as they come gets. Then the
+// input is replayed back to back until the stream holds at least --min-events events;
+// repetition r is shifted by r x (span + 1 us) so that time keeps increasing. Per detector:
 //  - throughput: --repeat passes over the whole stream, each with a freshly built detector
 //    (construction not timed), timed with steady_clock around detect() alone; ns/event
 //    median, min and max over the passes; max event rate = 1e9 / median ns/event.
@@ -13,9 +16,15 @@
 //    section (the clock's own overhead) is measured first and subtracted; it is printed.
 //    The timed pass runs slower than the throughput passes (the fences stop events from
 //    overlapping), so its percentiles bound a single event's latency from above.
+//  - --cpu-time: passes timed by the thread's CPU time instead of steady_clock (for a shared
+//    machine: it leaves out the time other processes hold the core).
 //  - --threads 1,2,...: the local detectors (the registry says which) also run split over
 //    that many threads (parallel_detect.hpp), timed the same way; thread start-up is
 //    outside the timing.
+// --yardstick: a plain exhaustive eFAST built into the tool (bench_command_yardstick.hpp),
+// compiled with the same compiler and flags; per input and detector the ratio of its cold
+// ns/event to the detector's cold ns/event (how many times faster than the yardstick), and the
+// median of those ratios over the inputs.
 // Data flows one way: the timing wraps the loop; the detectors know nothing of it.
 
 #include <algorithm>
@@ -44,6 +53,7 @@
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
 #include "evcorner/parallel_detect.hpp"
+#include "bench_command_yardstick.hpp"
 #include "progress.hpp"
 #include "std_streams.hpp"
 
@@ -70,6 +80,8 @@ struct BenchOptions {
     InputOptions in;
     std::string threads = "1";
     bool no_latency = false;
+    bool yardstick = false;
+    bool cpu_time = false;
     bool quiet = false;
     bool no_progress = false;
 };
@@ -86,6 +98,20 @@ struct Row {
     double median = 0, min = 0, max = 0;
     double p50 = 0, p99 = 0, p999 = 0;  // ns; 0 when not measured
     std::size_t memory = 0;
+    // Cold: one pass over the file itself per round (one thread only; empty otherwise).
+    std::vector<double> cold_ns_per_event;
+    double cold_median = 0;
+    std::uint64_t cold_corners = 0;
+    double yardstick_median = 0;  // the yardstick's cold ns/event on this input; 0 when not asked
+    std::uint64_t yardstick_corners = 0;
+};
+
+// The cold passes of one input: per round, the yardstick's and each detector's.
+struct ColdRuns {
+    std::vector<double> yardstick_ns;
+    std::uint64_t yardstick_corners = 0;
+    std::vector<std::vector<double>> ns;  // per detector, per round
+    std::vector<std::uint64_t> corners;   // per detector
 };
 
 // ----------------------------------------------------------------- machine description
@@ -233,7 +259,7 @@ using PassDone = std::function<void(std::uint64_t events)>;
 
 template <class Pass>
 Row timed_passes(const std::string& input, const std::string& name, int threads, SensorSize sensor,
-                 const std::vector<Event>& events, std::uint64_t file_events, int repeat, Pass pass,
+                 const std::vector<Event>& events, std::uint64_t file_events, int repeat, bool cpu_time, Pass pass,
                  const PassDone& done) {
     Row row;
     row.input = input;
@@ -246,9 +272,9 @@ Row timed_passes(const std::string& input, const std::string& name, int threads,
     const double n = static_cast<double>(events.size());
     for (int r = 0; r < repeat; ++r) {
         pass(row, flags, [&](auto&& run) {
-            const auto t0 = Clock::now();
+            const double t0 = bench_clock_ns(cpu_time);
             run();
-            row.ns_per_event.push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / n);
+            row.ns_per_event.push_back((bench_clock_ns(cpu_time) - t0) / n);
         });
         done(events.size());
     }
@@ -261,7 +287,7 @@ Row timed_passes(const std::string& input, const std::string& name, int threads,
 Row bench_one(const std::string& input, const std::string& name, SensorSize sensor,
               const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
               Latency& clock, const PassDone& done) {
-    Row row = timed_passes(input, name, 1, sensor, events, file_events, o.repeat,
+    Row row = timed_passes(input, name, 1, sensor, events, file_events, o.repeat, o.cpu_time,
                            [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
                                AnyDetector any = make_detector(config_for(name, o.detector_params), sensor, "--");
                                r.memory = memory_bytes(any);
@@ -288,12 +314,43 @@ Row bench_one(const std::string& input, const std::string& name, SensorSize sens
     return row;
 }
 
+/// The cold figures of one input: --repeat rounds over the file as it is (no replay); in each
+/// round the yardstick (when asked), then every detector once with a fresh detector.
+ColdRuns cold_runs(const std::vector<Event>& file, SensorSize sensor, const std::vector<std::string>& detectors,
+                   const BenchOptions& o, const PassDone& done) {
+    ColdRuns cold;
+    cold.ns.resize(detectors.size());
+    cold.corners.resize(detectors.size());
+    std::vector<std::uint8_t> flags(file.size());
+    const double n = static_cast<double>(file.size());
+    for (int r = 0; r < o.repeat; ++r) {
+        if (o.yardstick) {
+            const YardstickPass y = plain_efast_pass(std::span<const Event>(file), sensor, o.cpu_time);
+            cold.yardstick_ns.push_back(y.ns_per_event);
+            cold.yardstick_corners = y.corners;
+            done(file.size());
+        }
+        for (std::size_t d = 0; d < detectors.size(); ++d) {
+            AnyDetector any = make_detector(config_for(detectors[d], o.detector_params), sensor, "--");
+            std::visit(
+                [&](auto& det) {
+                    const double t0 = bench_clock_ns(o.cpu_time);
+                    cold.corners[d] = detect(det, std::span<const Event>(file), flags);
+                    cold.ns[d].push_back((bench_clock_ns(o.cpu_time) - t0) / n);
+                },
+                any);
+            done(file.size());
+        }
+    }
+    return cold;
+}
+
 /// Throughput passes with the sensor split over `threads` threads (parallel_detect.hpp).
 Row bench_parallel(const std::string& input, const std::string& name, int threads, SensorSize sensor,
                    const std::vector<Event>& events, std::uint64_t file_events, const BenchOptions& o,
                    const PassDone& done) {
     auto passes = [&](auto make_par) {
-        return timed_passes(input, name, threads, sensor, events, file_events, o.repeat,
+        return timed_passes(input, name, threads, sensor, events, file_events, o.repeat, o.cpu_time,
                             [&](Row& r, std::vector<std::uint8_t>& flags, auto time) {
                                 auto par = make_par();  // threads started outside the timing
                                 time([&] { r.corners = par->detect(std::span<const Event>(events), flags); });
@@ -328,50 +385,73 @@ std::string short_name(const std::string& path) {
 }
 
 void print_table(std::FILE* out, const std::vector<Row>& rows, const std::vector<std::string>& detectors,
-                 const std::vector<int>& thread_counts, bool latency) {
-    fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>7} {:>7} {:>7} {:>8}", "input", "detector", "thr", "events", "median",
-               "min", "max", "Mev/s");
+                 const std::vector<int>& thread_counts, bool latency, bool yardstick) {
+    fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>7} {:>7} {:>7} {:>8} {:>7} {:>8}", "input", "detector", "thr",
+               "events", "median", "min", "max", "Mev/s", "cold", "cold/rep");
+    if (yardstick) fmt::print(out, " {:>7} {:>7}", "yard", "x yard");
     if (latency) fmt::print(out, " {:>7} {:>7} {:>7}", "p50", "p99", "p99.9");
     fmt::print(out, " {:>11}\n", "memory [B]");
-    fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>23} {:>8}", "", "", "", "", "ns/event", "max rate");
+    fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>23} {:>8} {:>16}", "", "", "", "", "replayed ns/event", "max rate",
+               "cold ns/event");
+    if (yardstick) fmt::print(out, " {:>15}", "yardstick cold");
     if (latency) fmt::print(out, " {:>23}", "latency ns/event");
     fmt::print(out, "\n");
-    auto line = [&](const std::string& in, const std::string& det, int thr, std::uint64_t ev, double med, double mn,
-                    double mx, double p50, double p99, double p999, std::size_t mem) {
-        fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.2f}", in, det, thr, ev, med, mn,
-                   mx, med > 0 ? 1e3 / med : 0.0);
-        if (latency && p50 > 0)
-            fmt::print(out, " {:>7.0f} {:>7.0f} {:>7.0f}", p50, p99, p999);
+    // cold = 0: not measured (several threads); yard = 0: no yardstick.
+    auto line = [&](const std::string& in, const Row& r, double yard_ratio) {
+        fmt::print(out, "{:<34} {:<13} {:>3} {:>10} {:>7.1f} {:>7.1f} {:>7.1f} {:>8.2f}", in, r.detector, r.threads,
+                   r.events, r.median, r.min, r.max, r.median > 0 ? 1e3 / r.median : 0.0);
+        if (r.cold_median > 0)
+            fmt::print(out, " {:>7.1f} {:>8.2f}", r.cold_median, r.median > 0 ? r.cold_median / r.median : 0.0);
+        else
+            fmt::print(out, " {:>7} {:>8}", "-", "-");
+        if (yardstick && r.cold_median > 0 && r.yardstick_median > 0)
+            fmt::print(out, " {:>7.1f} {:>7.2f}", r.yardstick_median, yard_ratio);
+        else if (yardstick)
+            fmt::print(out, " {:>7} {:>7}", "-", "-");
+        if (latency && r.p50 > 0)
+            fmt::print(out, " {:>7.0f} {:>7.0f} {:>7.0f}", r.p50, r.p99, r.p999);
         else if (latency)
             fmt::print(out, " {:>7} {:>7} {:>7}", "-", "-", "-");
-        fmt::print(out, " {:>11}\n", mem);
+        fmt::print(out, " {:>11}\n", r.memory);
     };
-    for (const Row& r : rows)
-        line(short_name(r.input), r.detector, r.threads, r.events, r.median, r.min, r.max, r.p50, r.p99, r.p999, r.memory);
+    auto ratio = [](const Row& r) { return r.cold_median > 0 ? r.yardstick_median / r.cold_median : 0.0; };
+    for (const Row& r : rows) line(short_name(r.input), r, ratio(r));
     std::size_t files = 0;
     for (const Row& r : rows) files += r.detector == detectors.front() && r.threads == thread_counts.front();
     if (files < 2) return;
-    fmt::print(out, "\nmedian over the {} inputs of the per-input figures (min: smallest min, max: largest max):\n",
+    fmt::print(out,
+               "\nmedian over the {} inputs of the per-input figures (min: smallest min, max: largest max; "
+               "x yard: median of the per-input ratios):\n",
                files);
     for (const std::string& d : detectors)
     for (const int thr : thread_counts) {
-        std::vector<double> med, p50, p99, p999;
-        double mn = 1e300, mx = 0;
-        std::size_t mem = 0;
-        std::uint64_t events = 0;
+        std::vector<double> med, p50, p99, p999, cold, yard, ratios;
+        Row all;
+        all.detector = d;
+        all.threads = thr;
+        all.min = 1e300;
         for (const Row& r : rows) {
             if (r.detector != d || r.threads != thr) continue;
-            events += r.events;
+            all.events += r.events;
             med.push_back(r.median);
             p50.push_back(r.p50);
             p99.push_back(r.p99);
             p999.push_back(r.p999);
-            mn = std::min(mn, r.min);
-            mx = std::max(mx, r.max);
-            mem = std::max(mem, r.memory);
+            cold.push_back(r.cold_median);
+            yard.push_back(r.yardstick_median);
+            ratios.push_back(ratio(r));
+            all.min = std::min(all.min, r.min);
+            all.max = std::max(all.max, r.max);
+            all.memory = std::max(all.memory, r.memory);
         }
         if (med.empty()) continue;
-        line("all inputs", d, thr, events, median_of(med), mn, mx, median_of(p50), median_of(p99), median_of(p999), mem);
+        all.median = median_of(med);
+        all.p50 = median_of(p50);
+        all.p99 = median_of(p99);
+        all.p999 = median_of(p999);
+        all.cold_median = median_of(cold);
+        all.yardstick_median = median_of(yard);
+        line("all inputs", all, median_of(ratios));
     }
 }
 
@@ -384,6 +464,10 @@ void write_json(const std::string& path, const std::vector<Row>& rows, const std
     j["build_flags"] = EVCORNER_BUILD_FLAGS;
     j["efast_code_path"] = efast_code_path();
     j["repeat"] = o.repeat;
+    j["clock"] = o.cpu_time ? "thread CPU time" : "steady_clock";
+    j["yardstick"] = o.yardstick ? nlohmann::json("built-in plain exhaustive eFAST (bench_command_yardstick.cpp), "
+                                                  "same compiler and flags")
+                                 : nlohmann::json(nullptr);
     j["min_events"] = o.min_events;
     j["latency_clock_overhead_ns"] = o.no_latency ? nlohmann::json(nullptr) : nlohmann::json(clock.overhead_ns);
     j["latency_clock_resolution_ns"] = o.no_latency ? nlohmann::json(nullptr) : nlohmann::json(clock.resolution_ns);
@@ -409,6 +493,18 @@ void write_json(const std::string& path, const std::vector<Row>& rows, const std
             x["latency_ns_p999"] = r.p999;
         }
         x["memory_bytes"] = r.memory;
+        if (r.cold_median > 0) {
+            x["cold_events"] = r.file_events;
+            x["cold_corners"] = r.cold_corners;
+            x["cold_ns_per_event"] = r.cold_ns_per_event;
+            x["cold_ns_per_event_median"] = r.cold_median;
+            x["cold_vs_replayed"] = r.median > 0 ? r.cold_median / r.median : 0.0;
+            if (r.yardstick_median > 0) {
+                x["yardstick_ns_per_event_median"] = r.yardstick_median;
+                x["yardstick_ratio"] = r.yardstick_median / r.cold_median;
+                x["yardstick_corners"] = r.yardstick_corners;
+            }
+        }
         j["results"].push_back(std::move(x));
     }
     io::OutputFile out(path);
@@ -444,6 +540,8 @@ void run_bench(const BenchOptions& o) {
         thread_counts.push_back(k);
     }
     if (thread_counts.empty()) thread_counts.push_back(1);
+    if (o.cpu_time && std::any_of(thread_counts.begin(), thread_counts.end(), [](int k) { return k > 1; }))
+        throw std::invalid_argument("--cpu-time: one thread's CPU time does not time several threads; use --threads 1");
 
     const std::string cpu = cpu_model();
     fmt::print(out, "evcorner bench: {} input(s), detectors {}, {} pass(es) each over >= {} events\n",
@@ -451,9 +549,12 @@ void run_bench(const BenchOptions& o) {
     fmt::print(out, "CPU      {}\n", cpu);
     fmt::print(out, "build    {} build, {}, flags: {}; eFAST code path: {}\n", EVCORNER_BUILD_TYPE, compiler(),
                EVCORNER_BUILD_FLAGS, efast_code_path());
-    fmt::print(out, "method   one thread; throughput: steady_clock around detect() over the replayed stream,\n"
-               "         fresh detector per pass; latency: rdtscp/lfence around each event, clock overhead\n"
-               "         subtracted (fenced, so an upper bound)\n\n");
+    fmt::print(out, "method   one thread; throughput: {} around detect() over the replayed stream,\n",
+               o.cpu_time ? "thread CPU time" : "steady_clock");
+    fmt::print(out, "         fresh detector per pass; cold: the same over each file once (no replay){};\n"
+               "         latency: rdtscp/lfence around each event, clock overhead\n"
+               "         subtracted (fenced, so an upper bound)\n\n",
+               o.yardstick ? ", beside the yardstick (a built-in plain eFAST)" : "");
     flush_checked(out);
 
     // The progress bar counts passes: per input, each detector and thread count runs
@@ -462,8 +563,9 @@ void run_bench(const BenchOptions& o) {
     for (const std::string& d : detectors)
         for (const int thr : thread_counts) {
             if (thr > 1 && !detector_info(d).local()) continue;
-            runs_per_input += static_cast<std::uint64_t>(o.repeat) + (thr == 1 && !o.no_latency ? 1 : 0);
+            runs_per_input += static_cast<std::uint64_t>(o.repeat) * (thr == 1 ? 2 : 1) + (thr == 1 && !o.no_latency ? 1 : 0);
         }
+    if (o.yardstick) runs_per_input += static_cast<std::uint64_t>(o.repeat);
     Progress progress(!o.quiet && !o.no_progress, runs_per_input * o.inputs.size());
     std::uint64_t passes_done = 0, events_done = 0;
     const PassDone done = [&](std::uint64_t events) {
@@ -475,13 +577,14 @@ void run_bench(const BenchOptions& o) {
     Latency clock;
     for (const std::string& input : o.inputs) {
         SensorSize sensor;
-        std::vector<Event> stream;
+        std::vector<Event> stream, file_stream;
         std::uint64_t file_events = 0;
         {
             LoadedEvents file = load_events(input, o.in, !o.quiet && !o.no_progress);  // its own bar while reading
             sensor = file.size;
             file_events = file.events.size();
             stream = replay(file.events, o.min_events);
+            file_stream = std::move(file.events);
         }
         if (stream.empty()) {
             progress.finish();
@@ -489,11 +592,24 @@ void run_bench(const BenchOptions& o) {
             passes_done += runs_per_input;
             continue;
         }
-        for (const std::string& d : detectors)
+        const ColdRuns cold = cold_runs(file_stream, sensor, detectors, o, done);
+        progress.finish();
+        if (o.yardstick && !o.quiet)
+            fmt::print(stderr, "  {} yardstick: {:.1f} ns/event\n", short_name(input), median_of(cold.yardstick_ns));
+        for (std::size_t di = 0; di < detectors.size(); ++di)
             for (const int thr : thread_counts) {
+                const std::string& d = detectors[di];
                 if (thr > 1 && !detector_info(d).local()) continue;  // not local: one thread only
                 rows.push_back(thr == 1 ? bench_one(input, d, sensor, stream, file_events, o, clock, done)
                                         : bench_parallel(input, d, thr, sensor, stream, file_events, o, done));
+                if (thr == 1) {
+                    Row& row = rows.back();
+                    row.cold_ns_per_event = cold.ns[di];
+                    row.cold_median = median_of(cold.ns[di]);
+                    row.cold_corners = cold.corners[di];
+                    row.yardstick_median = o.yardstick ? median_of(cold.yardstick_ns) : 0.0;
+                    row.yardstick_corners = cold.yardstick_corners;
+                }
                 progress.finish();
                 flush_checked(out);
                 if (!o.quiet)
@@ -502,7 +618,7 @@ void run_bench(const BenchOptions& o) {
     }
     progress.finish();
     if (!o.quiet) fmt::print(stderr, "\n");
-    print_table(out, rows, detectors, thread_counts, !o.no_latency);
+    print_table(out, rows, detectors, thread_counts, !o.no_latency, o.yardstick);
     if (!o.no_latency)
         fmt::print(out, "\nlatency clock: overhead {:.1f} ns (subtracted), resolution {:.1f} ns\n", clock.overhead_ns,
                    clock.resolution_ns);
@@ -517,10 +633,13 @@ void add_bench_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "bench",
         "Benchmark the detectors on event files: the paper's Table 2 for this machine.\n"
-        "Each input is replayed (shifted in time per repetition) to at least --min-events\n"
-        "events; each detector runs --repeat times over it, one thread. Prints ns/event\n"
-        "(median, min, max), the maximum sustainable event rate, per-event latency\n"
-        "percentiles (p50, p99, p99.9), detector memory, the CPU model and build flags.");
+        "Cold: each detector runs --repeat times over each input as it is (one pass per\n"
+        "file, fresh detector). Replayed: each input is replayed (shifted in time per\n"
+        "repetition) to at least --min-events events; each detector runs --repeat times\n"
+        "over it, one thread. Prints ns/event (replayed median, min, max; cold median and\n"
+        "cold/replayed), the maximum sustainable event rate, per-event latency percentiles\n"
+        "(p50, p99, p99.9), detector memory, the CPU model and build flags; with\n"
+        "--yardstick also the cold speed as a multiple of a plain eFAST timed in the same run.");
     cmd->add_option("FILE", o->inputs, "Event files (any format evcorner reads)")->required();
     cmd->add_option("-d,--detectors", o->detectors,
                     "Comma-separated detectors to run, or all [default: all registered, each with its defaults "
@@ -546,12 +665,21 @@ void add_bench_command(CLI::App& app) {
                         "run on one")
         ->capture_default_str();
     cmd->add_flag("--no-latency", o->no_latency, "Skip the per-event latency pass");
+    cmd->add_flag("--yardstick", o->yardstick,
+                  "Also time the yardstick, a plain exhaustive eFAST built into the tool (same compiler and "
+                  "flags; the computation of ../shared/tools/plain-efast.cpp), cold on each input in the same "
+                  "rounds, and report each detector's cold speed as a multiple of it (x yard)");
+    cmd->add_flag("--cpu-time", o->cpu_time,
+                  "Time the throughput and cold passes (and the yardstick) by the thread's CPU time instead of "
+                  "the wall clock: on a shared machine it leaves out the time other processes hold the core "
+                  "(not what they do to the caches)");
     cmd->add_flag("-q,--quiet", o->quiet, "No per-run progress lines and no progress bar on standard error");
     cmd->add_flag("--no-progress", o->no_progress, "No progress bar (it shows only on a terminal)");
     cmd->footer(
         "Examples:\n"
         "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt\n"
-        "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt --min-events 1 --no-latency   # cold: one pass per file\n"
+        "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt --min-events 1 --no-latency   # cold only (no replay)\n"
+        "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt -d efast --yardstick --no-latency\n"
         "  evcorner bench recording.raw -d efast --repeat 9 --min-events 20000000 --json bench.json\n"
         "  evcorner bench hd.raw -d efast --threads 1,2          # multi-core speed-up");
     cmd->callback([o] { run_bench(*o); });

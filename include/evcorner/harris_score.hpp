@@ -9,7 +9,10 @@
 //
 // The patch is given as one bit mask per row (bit c = column c). Gradients are summed
 // in integers with 12*G (integer coefficients) and scaled once at the end, so the result
-// equals the double-precision definition up to rounding (~1e-15 relative).
+// equals the double-precision definition up to rounding (~1e-15 relative). For w = 9 the
+// gradients come five at a time from per-row tables (five 12-bit fields in one word), and
+// the products are summed exactly in integers per distinct Gaussian weight (6 of them)
+// before the 6 weights are applied.
 
 #include <array>
 #include <cstdint>
@@ -42,6 +45,7 @@ public:
 private:
     template <int W>
     [[nodiscard]] double score_fixed(const std::uint16_t* rows) const noexcept;
+    [[nodiscard]] double score9(const std::uint16_t* rows) const noexcept;
 
     int window_;
     double k_;
@@ -49,6 +53,13 @@ private:
     // Correlation of a 5-pixel run (bit j = column j) with the taps.
     std::array<std::int8_t, 32> smooth5_{};
     std::array<std::int8_t, 32> deriv5_{};
+    // The 9x9 window (the default): per 9-bit row, the five 5-wide runs' correlations packed
+    // in 12-bit fields of one word (field c = run at column c): smooth (0..16) and
+    // derivative + 3 (0..6), so that whole gradient rows are summed in one word (score9).
+    std::array<std::uint64_t, 512> smooth9_{};
+    std::array<std::uint64_t, 512> deriv9_{};
+    // The 5x5 Gaussian's distinct weights, by squared distance from the centre 0, 1, 2, 4, 5, 8.
+    std::array<double, 6> h9_{};
 };
 
 }  // namespace evcorner
