@@ -83,6 +83,11 @@ TEST_F(EvalTruthCli, SuiteFolderFindsEachTruthBesideItsEvents) {
     ASSERT_EQ(run("simulate scene.json -o suite/b.events.txt --truth suite/b.truth.csv -q").status, 0);
     fs::copy_file(dir_ / "scene.json", dir_ / "suite/a.json");
     write("suite/manifest.json", "{}");
+    // A scene wider than 240 px: its .npy events carry no size, the scene beside gives it.
+    write("suite/wide.json", R"({"sensor": [320, 40], "duration_s": 0.1, "seed": 1, "background": 0.5,
+        "objects": [{"polygon": [[270, 10], [290, 10], [290, 30], [270, 30]], "intensity": 0.1,
+                     "motion": {"velocity": [100, 0]}}]})");
+    ASSERT_EQ(run("simulate suite/wide.json -o suite/wide.events.npy --truth suite/wide.truth.csv -q").status, 0);
     const CliResult r = run("eval suite -d efast --repeat 1 --no-progress --no-figures");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.err.find("skipped"), std::string::npos) << r.err;  // truths, scenes and manifest are known
@@ -90,6 +95,7 @@ TEST_F(EvalTruthCli, SuiteFolderFindsEachTruthBesideItsEvents) {
     const auto a = r.out.find("\na "), b = r.out.find("\nb ");
     ASSERT_NE(a, std::string::npos) << r.out;
     ASSERT_NE(b, std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\nwide "), std::string::npos) << r.out;
     EXPECT_EQ(r.out.substr(a + 2, r.out.find('\n', a + 1) - a - 2), r.out.substr(b + 2, r.out.find('\n', b + 1) - b - 2));
 }
 

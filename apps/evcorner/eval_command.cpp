@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <fmt/format.h>
 #include <limits>
 #include <map>
@@ -81,6 +82,21 @@ fs::path truth_beside(const fs::path& events) {
     if (base.size() > 7 && base.ends_with(".events")) base.resize(base.size() - 7);
     const fs::path t = events.parent_path() / (base + ".truth.csv");
     return fs::is_regular_file(t) && t != events ? t : fs::path();
+}
+
+// The sensor ("WxH") of the simulated scene NAME.json beside NAME.truth.csv, for event files
+// that do not carry their size (.npy); empty when there is no such scene or it has no sensor.
+std::string scene_sensor_beside(const Sequence& seq) {
+    if (seq.truth.empty()) return {};
+    const std::string t = seq.truth.string();
+    const fs::path scene(t.substr(0, t.size() - 10) + ".json");
+    if (!fs::is_regular_file(scene)) return {};
+    std::ifstream in(scene);
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.contains("sensor") || !j["sensor"].is_array() || j["sensor"].size() != 2 ||
+        !j["sensor"][0].is_number_integer() || !j["sensor"][1].is_number_integer())
+        return {};
+    return fmt::format("{}x{}", j["sensor"][0].get<long long>(), j["sensor"][1].get<long long>());
 }
 
 // Files of a suite folder that are not event files: the truths, the scenes and the manifest.
@@ -554,7 +570,9 @@ void run_eval(EvalOptions& o) {
     std::vector<Event> batch(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
     for (const auto& seq : seqs) {
-        const auto reader = open_events(seq.file.string(), o.in);
+        InputOptions in = o.in;
+        if (in.size.empty()) in.size = scene_sensor_beside(seq);
+        const auto reader = open_events(seq.file.string(), in);
         const SensorSize size = sensor_of(*reader);
         std::vector<DetectorRuns> kinds;
         for (const DetectorConfig& config : configs) {
