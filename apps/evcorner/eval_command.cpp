@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <fmt/format.h>
 #include <limits>
 #include <map>
@@ -30,6 +31,9 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/eval/metrics.hpp"
+#include "evcorner/eval/truth_match.hpp"
+#include "evcorner/render/charts.hpp"
+#include "evcorner/sim/truth.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
 #include "evcorner/render/figures.hpp"
@@ -55,6 +59,12 @@ struct EvalOptions {
     InputOptions in;
     eval::FeatureTrackParams params;
     std::string overlap = "any";
+    // Against ground truth (a simulated scene's truth CSV).
+    std::string truth;
+    eval::TruthMatchParams match;
+    std::string credit = "all";
+    std::string interpolation = "linear";
+    std::vector<double> speed_edges;
 };
 
 struct Sequence {
@@ -62,7 +72,39 @@ struct Sequence {
     std::string base;  ///< the dataset's sequence name (folder of events.txt, else stem): the paper's rows
     fs::path file;
     std::string stem;  ///< the name as a file-name stem for the figures, unique too
+    fs::path truth;    ///< its ground truth (simulate --truth), empty when none
 };
+
+// The truth beside an event file written by simulate: NAME.truth.csv for NAME.events.EXT
+// (simulate --suite) or NAME.EXT; empty when there is none.
+fs::path truth_beside(const fs::path& events) {
+    std::string base = events.stem().string();
+    if (base.size() > 7 && base.ends_with(".events")) base.resize(base.size() - 7);
+    const fs::path t = events.parent_path() / (base + ".truth.csv");
+    return fs::is_regular_file(t) && t != events ? t : fs::path();
+}
+
+// The sensor ("WxH") of the simulated scene NAME.json beside NAME.truth.csv, for event files
+// that do not carry their size (.npy); empty when there is no such scene or it has no sensor.
+std::string scene_sensor_beside(const Sequence& seq) {
+    if (seq.truth.empty()) return {};
+    const std::string t = seq.truth.string();
+    const fs::path scene(t.substr(0, t.size() - 10) + ".json");
+    if (!fs::is_regular_file(scene)) return {};
+    std::ifstream in(scene);
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.contains("sensor") || !j["sensor"].is_array() || j["sensor"].size() != 2 ||
+        !j["sensor"][0].is_number_integer() || !j["sensor"][1].is_number_integer())
+        return {};
+    return fmt::format("{}x{}", j["sensor"][0].get<long long>(), j["sensor"][1].get<long long>());
+}
+
+// Files of a suite folder that are not event files: the truths, the scenes and the manifest.
+bool is_suite_companion(const fs::path& p) {
+    const std::string name = p.filename().string();
+    if (name.ends_with(".truth.csv") || name == "manifest.json") return true;
+    return p.extension() == ".json" && fs::is_regular_file(p.parent_path() / (p.stem().string() + ".truth.csv"));
+}
 
 // The paper's Table 1 (Red., FT in %): spatially-adaptive Harris, then eFAST.
 struct PaperRow {
@@ -153,7 +195,7 @@ std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
         if (fs::is_directory(p)) {
             if (fs::is_regular_file(p / "events.txt")) {
                 const std::string name = fs::absolute(p).lexically_normal().filename().string();
-                seqs.push_back({name, name, p / "events.txt", {}});
+                seqs.push_back({name, name, p / "events.txt", {}, {}});
                 continue;
             }
             // <sequence>/events.txt folders (the dataset's layout) and event files.
@@ -162,6 +204,7 @@ std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
                 if (d.is_directory()) {
                     if (fs::is_regular_file(d.path() / "events.txt")) dirs.push_back(d.path());
                 } else if (d.is_regular_file()) {
+                    if (is_suite_companion(d.path())) continue;
                     (has_event_extension(d.path()) ? files : skipped).push_back(d.path());
                 }
             }
@@ -176,15 +219,21 @@ std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
             }
             for (const auto& f : skipped)
                 fmt::print(stderr, "eval: {}: skipped, not an event file by its extension\n", f.string());
-            for (const auto& d : dirs) seqs.push_back({d.filename().string(), d.filename().string(), d / "events.txt", {}});
-            for (const auto& f : files) seqs.push_back({f.stem().string(), f.stem().string(), f, {}});
+            for (const auto& d : dirs) seqs.push_back({d.filename().string(), d.filename().string(), d / "events.txt", {}, {}});
+            for (const auto& f : files) seqs.push_back({f.stem().string(), f.stem().string(), f, {}, {}});
         } else {
             // events.txt in a sequence folder takes the folder's name, other files their stem.
             const std::string name = p.filename() == "events.txt" && p.has_parent_path()
                                          ? fs::absolute(p).parent_path().filename().string()
                                          : p.stem().string();
-            seqs.push_back({name, name, p, {}});
+            seqs.push_back({name, name, p, {}, {}});
         }
+    }
+    // A simulated scene's events take the scene's name and its truth.
+    for (Sequence& q : seqs) {
+        q.truth = truth_beside(q.file);
+        if (q.truth.empty()) continue;
+        q.name = q.base = q.truth.filename().string().substr(0, q.truth.filename().string().size() - 10);
     }
     make_names_unique(seqs);
     // Figure stems: the name's folders joined by '_'; one that meets another name's gets a number.
@@ -376,6 +425,109 @@ std::string paper_comparison_md(const eval::Table1& t, const std::map<std::strin
     return any ? s : std::string();
 }
 
+// One detector's precision and recall per speed bin, for the charts.
+struct ChartSeriesPair {
+    std::string name;
+    std::vector<double> precision, recall;
+};
+
+// One detector on one sequence against its ground truth.
+struct TruthRow {
+    std::string sequence, detector;
+    std::uint64_t events = 0, corners = 0, on_track = 0;
+    double detect_s = 0;
+    eval::TruthMatchResult m;
+    eval::ErrorSummary err;
+};
+
+std::string speed_bin_label(const eval::SpeedBin& b) {
+    return std::isinf(b.hi) ? fmt::format("{:g}+", b.lo) : fmt::format("{:g}-{:g}", b.lo, b.hi);
+}
+
+double us_per_event(const TruthRow& r) {
+    return r.events == 0 ? 0.0 : r.detect_s * 1e6 / static_cast<double>(r.events);
+}
+
+std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown) {
+    std::string s;
+    if (markdown) {
+        s += "| sequence | detector | corner events | precision % | recall % | loc. median px | loc. mean px | "
+             "loc. p90 px | Red. % | FT % | time/event us |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        for (const auto& r : rows)
+            s += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.1f} | {:.3f} |\n",
+                             r.sequence, r.detector, r.corners, r.m.precision(), r.m.recall(), r.err.median,
+                             r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners),
+                             eval::ft_percent(r.corners, r.on_track), us_per_event(r));
+        return s;
+    }
+    std::size_t w = 8;
+    for (const auto& r : rows) w = std::max(w, r.sequence.size());
+    s += fmt::format("{:<{}}  {:<14} {:>9} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>8}\n", "sequence", w, "detector",
+                     "corners", "P %", "R %", "med px", "mean", "p90", "Red.%", "FT %", "us/ev");
+    for (const auto& r : rows)
+        s += fmt::format("{:<{}}  {:<14} {:>9} {:>6.1f} {:>6.1f} {:>6.2f} {:>6.2f} {:>6.2f} {:>6.1f} {:>6.1f} {:>8.3f}\n",
+                         r.sequence, w, r.detector, r.corners, r.m.precision(), r.m.recall(), r.err.median, r.err.mean,
+                         r.err.p90, eval::reduction_rate(r.events, r.corners), eval::ft_percent(r.corners, r.on_track),
+                         us_per_event(r));
+    return s;
+}
+
+std::string truth_table_csv(const std::vector<TruthRow>& rows) {
+    std::string s =
+        "sequence,detector,events,corners,true_positives,precision_percent,truth_samples,recalled,recall_percent,"
+        "loc_median_px,loc_mean_px,loc_p90_px,reduction_percent,ft_percent,us_per_event\n";
+    for (const auto& r : rows)
+        s += fmt::format("{},{},{},{},{},{:.4f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.6f}\n", r.sequence,
+                         r.detector, r.events, r.corners, r.m.true_positives, r.m.precision(), r.m.truth_samples,
+                         r.m.recalled, r.m.recall(), r.err.median, r.err.mean, r.err.p90,
+                         eval::reduction_rate(r.events, r.corners), eval::ft_percent(r.corners, r.on_track),
+                         us_per_event(r));
+    return s;
+}
+
+std::string truth_speed_csv(const std::vector<TruthRow>& rows) {
+    std::string s = "sequence,detector,speed_lo,speed_hi,events,true_positives,precision_percent,samples,recalled,"
+                    "recall_percent\n";
+    for (const auto& r : rows)
+        for (const auto& b : r.m.bins)
+            s += fmt::format("{},{},{:g},{},{},{},{},{},{},{}\n", r.sequence, r.detector, b.lo,
+                             std::isinf(b.hi) ? std::string("inf") : fmt::format("{:g}", b.hi), b.events,
+                             b.true_positives,
+                             b.events ? fmt::format("{:.4f}", 100.0 * b.true_positives / b.events) : std::string(),
+                             b.samples, b.recalled,
+                             b.samples ? fmt::format("{:.4f}", 100.0 * b.recalled / b.samples) : std::string());
+    return s;
+}
+
+// Streams `truth` once past one matcher per detector; keeps, for the space-time figure,
+// the visible corners every millisecond (at most StreamFigures::kSample points).
+std::vector<eval::TruthMatchResult> match_against_truth(const fs::path& truth, const std::vector<DetectorRuns>& kinds,
+                                                        const eval::TruthMatchParams& params, bool progress,
+                                                        std::vector<Event>* tracks) {
+    std::vector<eval::TruthMatcher> matchers;
+    for (const DetectorRuns& k : kinds) matchers.emplace_back(k.corners, params);
+    sim::TruthReader reader(truth.string());
+    std::vector<sim::TruthCorner> rows;
+    Progress bar(progress, reader.bytes_total());
+    std::uint64_t n = 0;
+    std::int64_t next_keep = std::numeric_limits<std::int64_t>::min();
+    while (reader.next_sample(rows)) {
+        for (auto& m : matchers) m.add_sample(rows);
+        n += rows.size();
+        bar.update(reader.bytes_consumed(), n);
+        if (tracks && rows.front().t_us >= next_keep) {
+            next_keep = rows.front().t_us + 1000;
+            for (const auto& r : rows)
+                if (r.state == sim::CornerState::visible && tracks->size() < StreamFigures::kSample)
+                    tracks->push_back({r.t_us, static_cast<std::uint16_t>(std::max(0.0, r.x)),
+                                       static_cast<std::uint16_t>(std::max(0.0, r.y)), 1});
+        }
+    }
+    std::vector<eval::TruthMatchResult> out;
+    for (auto& m : matchers) out.push_back(m.finish());
+    return out;
+}
+
 void run_eval(EvalOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
     const std::vector<std::string> detectors = parse_detector_list(o.detectors);
@@ -385,13 +537,27 @@ void run_eval(EvalOptions& o) {
         configs.push_back(config_for(d, o.detector_params));
         check_detector_config(configs.back(), "--");
     }
-    const std::vector<Sequence> seqs = find_sequences(o.inputs);
+    std::vector<Sequence> seqs = find_sequences(o.inputs);
+    o.match.credit = eval::parse_credit(o.credit);
+    o.match.interpolation = eval::parse_interpolation(o.interpolation);
+    if (!o.speed_edges.empty()) o.match.speed_edges = o.speed_edges;
+    eval::validate(o.match);
+    if (!o.truth.empty()) {
+        if (seqs.size() != 1)
+            throw std::invalid_argument("--truth: give exactly one event file (got " + std::to_string(seqs.size()) +
+                                        " sequences); a suite folder finds each scene's truth beside its events");
+        seqs[0].truth = o.truth;
+    }
+    std::vector<TruthRow> truth_rows;
     fs::path fig_dir;
     if (!o.report.empty()) {
         // The report's files must not land on an input (--report pointing into the data).
         std::vector<io::NamedPath> inputs, outputs;
         for (const Sequence& seq : seqs) inputs.push_back({"INPUTS", seq.file.string()});
-        for (const char* name : {"table1.csv", "table2.csv", "results.json", "report.md"})
+        for (const Sequence& seq : seqs)
+            if (!seq.truth.empty()) inputs.push_back({"--truth", seq.truth.string()});
+        for (const char* name : {"table1.csv", "table2.csv", "results.json", "report.md", "truth_table.csv",
+                                 "truth_speed.csv"})
             outputs.push_back({"--report", (fs::path(o.report) / name).string()});
         io::check_output_paths(inputs, outputs);
         fs::create_directories(o.report);
@@ -399,12 +565,14 @@ void run_eval(EvalOptions& o) {
     }
     std::vector<eval::RunRecord> runs;
     nlohmann::json jruns = nlohmann::json::array();
-    std::string figures_md;
+    std::string figures_md, truth_figures_md, speed_figures_md;
     const bool show_progress = !o.quiet && !o.no_progress;
     std::vector<Event> batch(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
     for (const auto& seq : seqs) {
-        const auto reader = open_events(seq.file.string(), o.in);
+        InputOptions in = o.in;
+        if (in.size.empty()) in.size = scene_sensor_beside(seq);
+        const auto reader = open_events(seq.file.string(), in);
         const SensorSize size = sensor_of(*reader);
         std::vector<DetectorRuns> kinds;
         for (const DetectorConfig& config : configs) {
@@ -438,7 +606,14 @@ void run_eval(EvalOptions& o) {
                 bar.update(reader->bytes_consumed(), n_events);
             }
         }
+        std::vector<eval::TruthMatchResult> matched;
+        std::vector<Event> truth_tracks;
+        if (!seq.truth.empty()) {
+            if (!o.quiet) fmt::print(stderr, "eval: {}: matching against {}\n", seq.name, seq.truth.string());
+            matched = match_against_truth(seq.truth, kinds, o.match, show_progress, figs ? &truth_tracks : nullptr);
+        }
         if (!o.quiet) fmt::print(stderr, "eval: {}: {} events; labelling\n", seq.name, n_events);
+        std::vector<ChartSeriesPair> speed_series;
         for (DetectorRuns& k : kinds) {
             k.detectors.clear();  // their state is no longer needed
             std::vector<Event>& corners = k.corners;
@@ -452,6 +627,52 @@ void run_eval(EvalOptions& o) {
             const double label_s = std::chrono::duration<double>(Clock::now() - l0).count();
             eval::RunRecord r{seq.name, k.name, n_events, corners.size(), labels.labelled, eval::median(k.seconds)};
             runs.push_back(r);
+            nlohmann::json jtruth;
+            if (!matched.empty()) {
+                TruthRow tr{seq.name, k.name, n_events, corners.size(), labels.labelled, r.detect_s,
+                            std::move(matched[static_cast<std::size_t>(&k - kinds.data())]), {}};
+                tr.err = eval::summarize_errors(tr.m.errors);
+                nlohmann::json jbins = nlohmann::json::array();
+                ChartSeriesPair sp{k.name, {}, {}};
+                for (const auto& b : tr.m.bins) {
+                    jbins.push_back({{"speed_lo", b.lo},
+                                     {"speed_hi", std::isinf(b.hi) ? nlohmann::json(nullptr) : nlohmann::json(b.hi)},
+                                     {"events", b.events},
+                                     {"true_positives", b.true_positives},
+                                     {"samples", b.samples},
+                                     {"recalled", b.recalled}});
+                    sp.precision.push_back(b.events ? 100.0 * b.true_positives / b.events : std::nan(""));
+                    sp.recall.push_back(b.samples ? 100.0 * b.recalled / b.samples : std::nan(""));
+                }
+                speed_series.push_back(std::move(sp));
+                jtruth = {{"file", seq.truth.string()},
+                          {"true_positives", tr.m.true_positives},
+                          {"precision_percent", tr.m.precision()},
+                          {"truth_samples", tr.m.truth_samples},
+                          {"recalled", tr.m.recalled},
+                          {"recall_percent", tr.m.recall()},
+                          {"loc_median_px", tr.err.median},
+                          {"loc_mean_px", tr.err.mean},
+                          {"loc_p90_px", tr.err.p90},
+                          {"speed_bins", jbins}};
+                if (figs && !figs->empty()) {
+                    const std::string stem = seq.stem + "." + k.name;
+                    render::write_png((fig_dir / (stem + ".loc_error.png")).string(),
+                                      render::render_histogram(seq.name + " " + k.name + ": localisation error of " +
+                                                                   std::to_string(tr.m.true_positives) + " true positives",
+                                                               tr.m.errors, 0.0, o.match.radius, 14, "px"));
+                    render::write_png((fig_dir / (stem + ".truth_space_time.png")).string(),
+                                      render::render_space_time(truth_tracks, corners, tr.m.is_true, size,
+                                                                figs->first_t(),
+                                                                std::max(figs->last_t(), figs->first_t() + 1)));
+                    truth_figures_md += fmt::format(
+                        "| {} | {} | ![](figures/{}.loc_error.png) | ![](figures/{}.truth_space_time.png) |\n",
+                        seq.name, k.name, stem, stem);
+                }
+                tr.m.errors = {};
+                tr.m.is_true = {};
+                truth_rows.push_back(std::move(tr));
+            }
             jruns.push_back({{"sequence", r.sequence},
                              {"file", seq.file.string()},
                              {"detector", r.detector},
@@ -464,7 +685,8 @@ void run_eval(EvalOptions& o) {
                              {"detect_s_runs", k.seconds},
                              {"tracks_accepted", labels.accepted},
                              {"hypotheses", labels.hypotheses},
-                             {"label_s", label_s}});
+                             {"label_s", label_s},
+                             {"truth", jtruth}});
             if (figs && !figs->empty()) {
                 const std::int64_t t_first = figs->first_t(), t_last = figs->last_t();
                 const std::string stem = seq.stem + "." + k.name;
@@ -477,6 +699,23 @@ void run_eval(EvalOptions& o) {
                                           seq.name, k.name, stem, stem);
             }
             if (&k != &kinds.front()) std::vector<Event>().swap(corners);  // the first detector's draw Fig. 1b
+        }
+        if (!speed_series.empty() && !fig_dir.empty()) {
+            std::vector<std::string> cats;
+            for (const auto& b : truth_rows.back().m.bins) cats.push_back(speed_bin_label(b));
+            std::vector<render::ChartSeries> ps, rs;
+            for (std::size_t i = 0; i < speed_series.size(); ++i) {
+                ps.push_back({speed_series[i].name, render::series_colour(i), speed_series[i].precision});
+                rs.push_back({speed_series[i].name, render::series_colour(i), speed_series[i].recall});
+            }
+            render::write_png((fig_dir / (seq.stem + ".precision_speed.png")).string(),
+                              render::render_line_chart(seq.name + ": precision against image speed (px/s)", cats, ps,
+                                                        100, "%"));
+            render::write_png((fig_dir / (seq.stem + ".recall_speed.png")).string(),
+                              render::render_line_chart(seq.name + ": recall against image speed (px/s)", cats, rs,
+                                                        100, "%"));
+            speed_figures_md += fmt::format("| {} | ![](figures/{}.precision_speed.png) | ![](figures/{}.recall_speed.png) |\n",
+                                            seq.name, seq.stem, seq.stem);
         }
         if (figs && !figs->empty()) {
             const std::int64_t t_first = figs->first_t(), t_last = figs->last_t();
@@ -494,6 +733,14 @@ void run_eval(EvalOptions& o) {
     fmt::print("Table 1: reduction rate (Red.) and corners on feature tracks (FT), %\n{}\n", table1_text(t1, false));
     fmt::print("Table 2: detection time per event (median of {} runs) and max. event rate\n{}", o.repeat,
                table2_text(t2, false));
+    const std::string match_rule = fmt::format(
+        "a corner event (pixel centre) is true when a visible truth corner lies within {} px of it at its time "
+        "(truth interpolated: {}); recall: visible truth samples with a matching corner event within {} us; "
+        "an event near several corners credits {} (docs/evaluation.md)",
+        o.match.radius, eval::to_string(o.match.interpolation), o.match.tolerance_us,
+        o.match.credit == eval::Credit::all ? "all of them" : "the nearest");
+    if (!truth_rows.empty())
+        fmt::print("\nAgainst ground truth: {}\n{}", match_rule, truth_table_text(truth_rows, false));
     if (o.report.empty()) return;
     const fs::path dir(o.report);
     write_file(dir / "table1.csv", table1_csv(runs));
@@ -517,6 +764,16 @@ void run_eval(EvalOptions& o) {
                        {"us_per_event", r.us_per_event},
                        {"max_event_rate", r.max_event_rate}});
     j["table2"] = jt2;
+    if (!truth_rows.empty()) {
+        write_file(dir / "truth_table.csv", truth_table_csv(truth_rows));
+        write_file(dir / "truth_speed.csv", truth_speed_csv(truth_rows));
+        nlohmann::json edges = o.match.speed_edges;
+        j["truth_match"] = {{"radius_px", o.match.radius},
+                            {"tolerance_us", o.match.tolerance_us},
+                            {"credit", std::string(eval::to_string(o.match.credit))},
+                            {"interpolation", std::string(eval::to_string(o.match.interpolation))},
+                            {"speed_edges", edges}};
+    }
     write_file(dir / "results.json", j.dump(2) + "\n");
     std::string md = "# evcorner evaluation\n\n";
     md += fmt::format(
@@ -538,6 +795,21 @@ void run_eval(EvalOptions& o) {
                           "the name of the folder holding events.txt), so there is nothing to set beside it.\n\n"
                         : paper + "\n";
     md += "## Table 2: time per event\n\n" + table2_text(t2, true) + "\n";
+    if (!truth_rows.empty()) {
+        md += "## Against ground truth (simulated scenes)\n\nMatching: " + match_rule +
+              ". Precision and FT side by side: FT counts corner events on feature tracks found in the detector's "
+              "own output, precision those within the radius of a true corner.\n\n" +
+              truth_table_text(truth_rows, true) + "\n";
+        if (!speed_figures_md.empty())
+            md += "### Precision and recall against image speed\n\nAn event counts in the speed bin of the nearest "
+                  "visible corner at its time, a truth sample in its own (truth_speed.csv has the counts).\n\n"
+                  "| sequence | precision | recall |\n|---|---|---|\n" + speed_figures_md + "\n";
+        if (!truth_figures_md.empty())
+            md += "### Localisation error and corner events over the truth\n\nHistogram of the true positives' "
+                  "distance to the nearest corner; space-time: visible truth corners every millisecond grey, corner "
+                  "events green when true, red when not.\n\n| sequence | detector | localisation error | "
+                  "space-time |\n|---|---|---|---|\n" + truth_figures_md + "\n";
+    }
     md += "Paper (one core of an i7-3720QM, 2.6 GHz): Harris 11.6 us / 86,230 e/s; eFAST 0.78 us / 1,275,000 e/s.\n\n";
     if (!figures_md.empty()) {
         md += "## Figures\n\nCorners of the last 33 ms (bright) and 100 ms (dark), green ON, red OFF (Fig. 6); "
@@ -590,11 +862,42 @@ void add_eval_command(CLI::App& app) {
     cmd->add_flag("--no-progress", o->no_progress, "No progress bars (shown only when stderr is a terminal)");
     add_load_options(*cmd, o->in);
     add_feature_track_options(*cmd, o->params, o->overlap);
+    const auto tg = "Against ground truth (docs/evaluation.md)";
+    cmd->add_option("--truth", o->truth,
+                    "Ground-truth CSV of the one input (evcorner simulate --truth) [default: NAME.truth.csv beside "
+                    "NAME.events.EXT or NAME.EXT, as simulate --suite writes them]")
+        ->check(CLI::ExistingFile)
+        ->group(tg);
+    cmd->add_option("--match-radius", o->match.radius, "A corner event is true within this distance of a corner, px")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber)
+        ->group(tg);
+    cmd->add_option("--match-tolerance", o->match.tolerance_us,
+                    "Recall: a truth sample is found by a matching corner event this close in time, us")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber)
+        ->group(tg);
+    cmd->add_option("--match-credit", o->credit,
+                    "An event near several corners credits all of them, or only the nearest, for recall")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"all", "nearest"}))
+        ->group(tg);
+    cmd->add_option("--match-interpolation", o->interpolation,
+                    "Truth between samples: linear, or the nearest sample")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"linear", "nearest"}))
+        ->group(tg);
+    cmd->add_option("--speed-bins", o->speed_edges,
+                    "Image-speed bin edges, px/s, from 0, increasing [default: 0,50,100,200,400,700]")
+        ->delimiter(',')
+        ->group(tg);
     cmd->footer(
         "Examples:\n"
         "  evcorner eval ../shared/data/real/ecd-stppp --report eval-report\n"
         "  evcorner eval a/events.txt b.txt -d efast,harris --repeat 3\n"
-        "  evcorner eval ../shared/data/real/ecd-stppp -d all --harris-window 7 --no-figures");
+        "  evcorner eval ../shared/data/real/ecd-stppp -d all --harris-window 7 --no-figures\n"
+        "  evcorner eval scene.npy --truth scene.truth.csv --report r     (simulate -o scene.npy --truth ...)\n"
+        "  evcorner eval suite/ --report r                                (simulate --suite suite/)");
     cmd->callback([o] { run_eval(*o); });
 }
 

@@ -18,6 +18,21 @@ constexpr double kSnap = 1e-12;
 // Largest move of any vertex in one step, px (mark_edges needs less than 1).
 constexpr double kMaxMove = 0.75;
 constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
+
+// Sorts a row's spans and merges those that overlap or touch: the canonical form of the set
+// of columns they cover (the same set gives the same spans, whatever the order given).
+void canonical_spans(std::vector<std::pair<int, int>>& row) {
+    if (row.size() < 2) return;
+    std::sort(row.begin(), row.end());
+    std::size_t k = 0;
+    for (std::size_t i = 1; i < row.size(); ++i) {
+        if (row[i].first <= row[k].second + 1)
+            row[k].second = std::max(row[k].second, row[i].second);
+        else
+            row[++k] = row[i];
+    }
+    row.resize(k + 1);
+}
 }  // namespace
 
 Simulator::Simulator(Scene scene)
@@ -50,6 +65,11 @@ Simulator::Simulator(Scene scene)
     }
     render(true);
     cur_ = next_;
+    cur_marks_.resize(static_cast<std::size_t>(h_));
+    prev_marks_.resize(static_cast<std::size_t>(h_));
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o)
+        if (moving_[o]) mark_edges(polys_[o], prev_marks_);
+    for (auto& row : prev_marks_) canonical_spans(row);
 
     const CameraParams& cam = scene_.camera;
     lref_.resize(n);
@@ -119,7 +139,8 @@ void Simulator::place_objects(double t_us) {
     }
 }
 
-void Simulator::mark_edges(const std::vector<std::vector<Vec2>>& pieces) {
+
+void Simulator::mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::vector<std::vector<std::pair<int, int>>>& spans) {
     // Every cell an edge touches, widened by one pixel on each side and one row up and down:
     // with edges moving less than a pixel per step (step()), every pixel whose coverage
     // changes touches an edge before or after the step.
@@ -146,7 +167,7 @@ void Simulator::mark_edges(const std::vector<std::vector<Vec2>>& pieces) {
                 if (hi_x < -1 || lo_x >= w_ + 1) continue;
                 const int lo = std::max(0, static_cast<int>(std::floor(std::max(lo_x, -2.0))) - 1);
                 const int hi = std::min(w_ - 1, static_cast<int>(std::floor(std::min(hi_x, w_ + 1.0))) + 1);
-                if (lo <= hi) spans_[static_cast<std::size_t>(r)].push_back({lo, hi});
+                if (lo <= hi) spans[static_cast<std::size_t>(r)].push_back({lo, hi});
             }
         }
     }
@@ -157,23 +178,17 @@ double Simulator::render(bool all_rows) {
     if (all_rows) {
         for (auto& row : spans_) row.push_back({0, w_ - 1});
     } else {
-        for (std::size_t o = 0; o < rects_.size(); ++o) {
-            if (!moving_[o]) continue;
-            mark_edges(prev_polys_[o]);
-            mark_edges(polys_[o]);
-        }
-        // Sorted, disjoint spans per row.
-        for (auto& row : spans_) {
-            if (row.size() < 2) continue;
-            std::sort(row.begin(), row.end());
-            std::size_t k = 0;
-            for (std::size_t i = 1; i < row.size(); ++i) {
-                if (row[i].first <= row[k].second + 1)
-                    row[k].second = std::max(row[k].second, row[i].second);
-                else
-                    row[++k] = row[i];
-            }
-            row.resize(k + 1);
+        // The pixels near the moving edges now (cur_marks_) and at time_us() (prev_marks_,
+        // kept from the step that reached it): sorted, disjoint spans per row.
+        for (auto& row : cur_marks_) row.clear();
+        for (std::size_t o = 0; o < rects_.size(); ++o)
+            if (moving_[o]) mark_edges(polys_[o], cur_marks_);
+        for (std::size_t y = 0; y < spans_.size(); ++y) {
+            canonical_spans(cur_marks_[y]);
+            auto& row = spans_[y];
+            row.insert(row.end(), cur_marks_[y].begin(), cur_marks_[y].end());
+            row.insert(row.end(), prev_marks_[y].begin(), prev_marks_[y].end());
+            if (!cur_marks_[y].empty() && !prev_marks_[y].empty()) canonical_spans(row);
         }
     }
     const std::size_t w = static_cast<std::size_t>(w_);
@@ -197,8 +212,11 @@ double Simulator::render(bool all_rows) {
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
         for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-            accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_);
-            if (multi) accumulate_polygon(polys_[o][k], obj.pieces[k].intensity, acc_int_.data(), stride_, w_, h_);
+            if (multi)
+                accumulate_polygon2(polys_[o][k], 1.0, acc_cov_.data(), obj.pieces[k].intensity, acc_int_.data(),
+                                    stride_, w_, h_);
+            else
+                accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_);
         }
         const double level = obj.pieces[0].intensity;
         const int xend = std::min(r.x1 + 1, w_);
@@ -212,13 +230,15 @@ double Simulator::render(bool all_rows) {
             for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)]) {
                 if (hi < r.x0) continue;
                 if (lo > r.x1) break;
-                for (; x < lo; ++x) {
-                    b += ac[x];
-                    ac[x] = 0;
-                    if (multi) {
-                        s += ai[x];
-                        ai[x] = 0;
+                // Adding 0 leaves a sum as it is: only the columns an edge wrote are read.
+                if (multi) {
+                    for (; x < lo; ++x) {
+                        if (ac[x] != 0) b += ac[x], ac[x] = 0;
+                        if (ai[x] != 0) s += ai[x], ai[x] = 0;
                     }
+                } else {
+                    for (; x < lo; ++x)
+                        if (ac[x] != 0) b += ac[x], ac[x] = 0;
                 }
                 const int last = std::min(hi, r.x1);
                 for (; x <= last; ++x) {
@@ -234,9 +254,9 @@ double Simulator::render(bool all_rows) {
                 }
             }
             // Clear what the edges left to the right of the last dirty column.
-            for (; x <= xend; ++x) {
-                ac[x] = 0;
-                if (multi) ai[x] = 0;
+            if (x <= xend) {
+                std::fill(ac + x, ac + xend + 1, 0.0);
+                if (multi) std::fill(ai + x, ai + xend + 1, 0.0);
             }
         }
     }
@@ -366,6 +386,7 @@ bool Simulator::step(std::vector<Event>& out) {
         out.insert(out.end(), step_events_.begin(), step_events_.end());
         prev_rects_ = rects_;
         prev_polys_ = polys_;
+        prev_marks_.swap(cur_marks_);
         ++stats_.steps;
         stats_.max_step_change = std::max(stats_.max_step_change, change / scene_.camera.contrast);
         dt_ = std::min(sp.max_step_us, change > 0 ? taken * std::clamp(0.9 * limit / change, 0.5, 2.0) : 2.0 * taken);

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <fmt/format.h>
+#include <filesystem>
 #include <fstream>
 
 #include "evcorner/error.hpp"
@@ -102,55 +103,97 @@ T field(std::string_view s, const std::string& path, std::uint64_t line, const c
 
 }  // namespace
 
-std::vector<TruthCorner> read_truth_csv(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path, "cannot open");
+struct TruthReader::Impl {
+    std::ifstream in;
     std::string text;
-    std::uint64_t line_no = 0;
-    std::vector<TruthCorner> rows;
-    if (!std::getline(in, text)) throw InputError(path, "empty file: expected the header " + std::string(kTruthHeader));
-    ++line_no;
+    std::vector<std::string_view> f;
+};
+
+TruthReader::TruthReader(const std::string& path) : path_(path), in_(std::make_unique<Impl>()) {
+    in_->in.open(path, std::ios::binary);
+    if (!in_->in) throw InputError(path, "cannot open");
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    total_ = ec ? 0 : static_cast<std::uint64_t>(size);
+    std::string& text = in_->text;
+    if (!std::getline(in_->in, text)) throw InputError(path, "empty file: expected the header " + std::string(kTruthHeader));
+    ++line_no_;
+    consumed_ += text.size() + 1;
     if (!text.empty() && text.back() == '\r') text.pop_back();
     if (text != kTruthHeader) throw InputError(path, InputError::Unit::line, 1, "expected the header " + std::string(kTruthHeader));
-    std::vector<std::string_view> f;
-    while (std::getline(in, text)) {
-        ++line_no;
-        if (!text.empty() && text.back() == '\r') text.pop_back();
-        if (text.empty()) continue;
-        f.clear();
-        std::size_t start = 0;
-        for (;;) {
-            const std::size_t comma = text.find(',', start);
-            f.emplace_back(std::string_view(text).substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-            if (comma == std::string::npos) break;
-            start = comma + 1;
+}
+
+TruthReader::~TruthReader() = default;
+
+bool TruthReader::read_row(TruthCorner& r) {
+    std::string& text = in_->text;
+    std::vector<std::string_view>& f = in_->f;
+    const std::string& path = path_;
+    for (;;) {
+        if (!std::getline(in_->in, text)) {
+            if (in_->in.bad()) throw InputError(path, "read failed");
+            return false;
         }
-        if (f.size() != 11)
-            throw InputError(path, InputError::Unit::line, line_no, "expected 11 fields, got " + std::to_string(f.size()));
-        TruthCorner r;
-        r.t_us = field<std::int64_t>(f[0], path, line_no, "t_us");
-        r.object = field<int>(f[1], path, line_no, "object");
-        r.corner = field<int>(f[2], path, line_no, "corner");
-        r.x = field<double>(f[3], path, line_no, "x");
-        r.y = field<double>(f[4], path, line_no, "y");
-        r.angle_deg = field<double>(f[5], path, line_no, "angle_deg");
-        r.vx = field<double>(f[6], path, line_no, "vx");
-        r.vy = field<double>(f[7], path, line_no, "vy");
-        (void)field<double>(f[8], path, line_no, "speed");
-        const int vis = field<int>(f[9], path, line_no, "visible");
-        if (f[10] == "visible") r.state = CornerState::visible;
-        else if (f[10] == "occluded") r.state = CornerState::occluded;
-        else if (f[10] == "outside") r.state = CornerState::outside;
-        else throw InputError(path, InputError::Unit::line, line_no, "state must be visible, occluded or outside");
-        if (vis != (r.state == CornerState::visible ? 1 : 0))
-            throw InputError(path, InputError::Unit::line, line_no, "visible disagrees with state");
-        if (r.object < 0 || r.corner < 0) throw InputError(path, InputError::Unit::line, line_no, "negative index");
-        if (!rows.empty() && r.t_us < rows.back().t_us)
-            throw InputError(path, InputError::Unit::line, line_no, "rows out of time order");
+        ++line_no_;
+        consumed_ += text.size() + 1;
+        if (!text.empty() && text.back() == '\r') text.pop_back();
+        if (!text.empty()) break;
+    }
+    const std::uint64_t line_no = line_no_;
+    f.clear();
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t comma = text.find(',', start);
+        f.emplace_back(std::string_view(text).substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    if (f.size() != 11)
+        throw InputError(path, InputError::Unit::line, line_no, "expected 11 fields, got " + std::to_string(f.size()));
+    r.t_us = field<std::int64_t>(f[0], path, line_no, "t_us");
+    r.object = field<int>(f[1], path, line_no, "object");
+    r.corner = field<int>(f[2], path, line_no, "corner");
+    r.x = field<double>(f[3], path, line_no, "x");
+    r.y = field<double>(f[4], path, line_no, "y");
+    r.angle_deg = field<double>(f[5], path, line_no, "angle_deg");
+    r.vx = field<double>(f[6], path, line_no, "vx");
+    r.vy = field<double>(f[7], path, line_no, "vy");
+    (void)field<double>(f[8], path, line_no, "speed");
+    const int vis = field<int>(f[9], path, line_no, "visible");
+    if (f[10] == "visible") r.state = CornerState::visible;
+    else if (f[10] == "occluded") r.state = CornerState::occluded;
+    else if (f[10] == "outside") r.state = CornerState::outside;
+    else throw InputError(path, InputError::Unit::line, line_no, "state must be visible, occluded or outside");
+    if (vis != (r.state == CornerState::visible ? 1 : 0))
+        throw InputError(path, InputError::Unit::line, line_no, "visible disagrees with state");
+    if (r.object < 0 || r.corner < 0) throw InputError(path, InputError::Unit::line, line_no, "negative index");
+    if (r.t_us < last_t_) throw InputError(path, InputError::Unit::line, line_no, "rows out of time order");
+    last_t_ = r.t_us;
+    return true;
+}
+
+bool TruthReader::next_sample(std::vector<TruthCorner>& rows) {
+    rows.clear();
+    if (!has_pending_ && !read_row(pending_)) return false;
+    has_pending_ = false;
+    rows.push_back(pending_);
+    TruthCorner r;
+    while (read_row(r)) {
+        if (r.t_us != rows.front().t_us) {
+            pending_ = r;
+            has_pending_ = true;
+            break;
+        }
         rows.push_back(r);
     }
-    if (in.bad()) throw InputError(path, "read failed");
-    return rows;
+    return true;
+}
+
+std::vector<TruthCorner> read_truth_csv(const std::string& path) {
+    TruthReader reader(path);
+    std::vector<TruthCorner> all, rows;
+    while (reader.next_sample(rows)) all.insert(all.end(), rows.begin(), rows.end());
+    return all;
 }
 
 }  // namespace evcorner::sim

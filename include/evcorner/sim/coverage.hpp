@@ -25,6 +25,11 @@ namespace evcorner::sim {
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
                         int height) noexcept;
 
+/// accumulate_polygon into acc with weight and into acc2 with weight2 in one walk of the
+/// edges; each array gets exactly the values two separate calls would give.
+void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
+                         std::size_t stride, int width, int height) noexcept;
+
 /// The same, also appending to touched[r] every column k of row r whose acc entry it changes
 /// (the running sum of a row changes only at those columns).
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,

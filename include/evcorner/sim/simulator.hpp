@@ -70,7 +70,7 @@ private:
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
     double render(bool all_rows);     // renders into next_ over the dirty rows; returns max |dL| bound
-    void mark_edges(const std::vector<std::vector<Vec2>>& pieces);
+    void mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::vector<std::vector<std::pair<int, int>>>& spans);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
     void emit_noise(double t1, std::vector<Event>& step_events);
@@ -92,6 +92,9 @@ private:
     std::vector<Rect> rects_, prev_rects_;
     std::vector<char> moving_;
     std::vector<std::vector<std::pair<int, int>>> spans_;  // each row's dirty columns, inclusive, sorted, disjoint
+    // The pixels near the moving edges at the time being rendered and at time_us() (the
+    // previous accepted step's cur_marks_): their union is spans_.
+    std::vector<std::vector<std::pair<int, int>>> cur_marks_, prev_marks_;
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
     double noise_rate_per_us_ = 0;

@@ -76,9 +76,37 @@ private:
     std::uint64_t rows_ = 0;
 };
 
-/// Reads a truth CSV written by TruthWriter. Throws InputError "FILE:LINE: reason" for a
-/// wrong header, a row with the wrong number of fields, a field that is not a number, a
-/// state other than the three, visible disagreeing with state, or rows out of time order.
+/// Reads a truth CSV written by TruthWriter one sample time at a time, so that a long
+/// truth (hundreds of MB) is never all in memory: next_sample() returns the rows of the next
+/// t_us. Throws InputError "FILE:LINE: reason" for a wrong header, a row with the wrong number
+/// of fields, a field that is not a number, a state other than the three, visible disagreeing
+/// with state, or rows out of time order.
+class TruthReader {
+public:
+    explicit TruthReader(const std::string& path);
+    ~TruthReader();
+    TruthReader(const TruthReader&) = delete;
+    TruthReader& operator=(const TruthReader&) = delete;
+
+    /// Replaces `rows` with every row of the next sample time; false (rows empty) at the end.
+    bool next_sample(std::vector<TruthCorner>& rows);
+    [[nodiscard]] const std::string& path() const noexcept { return path_; }
+    /// Bytes read so far and the file's size (for a progress bar).
+    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept { return consumed_; }
+    [[nodiscard]] std::uint64_t bytes_total() const noexcept { return total_; }
+
+private:
+    bool read_row(TruthCorner& r);
+    std::string path_;
+    struct Impl;
+    std::unique_ptr<Impl> in_;
+    std::uint64_t line_no_ = 0, consumed_ = 0, total_ = 0;
+    std::int64_t last_t_ = INT64_MIN;
+    bool has_pending_ = false;
+    TruthCorner pending_;
+};
+
+/// Every row of a truth CSV in memory (tests, small scenes); the errors of TruthReader.
 std::vector<TruthCorner> read_truth_csv(const std::string& path);
 
 }  // namespace evcorner::sim
