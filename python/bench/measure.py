@@ -91,7 +91,7 @@ def main():
     from evcorner import batch
     for workers in (1, 2):
         t0 = time.perf_counter()
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0")
         client = Client(cluster)
         client.wait_for_workers(workers)
         up = time.perf_counter() - t0

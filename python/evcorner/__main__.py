@@ -75,7 +75,7 @@ def main(argv=None):
         if args.workers < 1:
             parser.error("--workers must be at least 1")
         cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None)
+                               dashboard_address=":0")
         client = Client(cluster)
     up_s = time.perf_counter() - start
     try:
