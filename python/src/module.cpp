@@ -187,6 +187,22 @@ std::string cpp_class_name() {
     return std::string(s);
 }
 
+/// (width, height), or None.
+py::object size_or_none(const std::optional<SensorSize>& s) {
+    if (!s) return py::none();
+    return py::make_tuple(s->width, s->height);
+}
+
+/// A ReaderOptions size field as a Python property: (width, height) or None.
+template <auto Member>
+void def_size_property(py::class_<io::ReaderOptions>& c, const char* name) {
+    c.def_property(
+        name, [](const io::ReaderOptions& o) { return size_or_none(o.*Member); },
+        [](io::ReaderOptions& o, std::optional<std::pair<int, int>> s) {
+            o.*Member = s ? std::optional(SensorSize{s->first, s->second}) : std::nullopt;
+        });
+}
+
 SensorSize sensor_of(int width, int height) { return SensorSize{width, height}; }
 
 /// One registered detector, stateful across calls.
@@ -318,11 +334,7 @@ public:
         return py::int_(buf_[pos_].t);
     }
 
-    [[nodiscard]] py::object sensor() const {
-        const auto s = reader_->sensor();
-        if (!s) return py::none();
-        return py::make_tuple(s->width, s->height);
-    }
+    [[nodiscard]] py::object sensor() const { return size_or_none(reader_->sensor()); }
     [[nodiscard]] std::string format() const { return std::string(reader_->format()); }
     [[nodiscard]] std::string name() const { return reader_->name(); }
     [[nodiscard]] std::uint64_t skipped() const { return reader_->skipped(); }
@@ -517,26 +529,11 @@ PYBIND11_MODULE(_evcorner, m) {
         .def_readonly("corners", &PyDetector::corners_)
         .def_readonly("last_address", &PyDetector::last_address_);
 
-    py::class_<io::ReaderOptions>(m, "ReaderOptions")
-        .def(py::init<>())
-        .def_property(
-            "sensor",
-            [](const io::ReaderOptions& o) -> py::object {
-                if (!o.sensor) return py::none();
-                return py::make_tuple(o.sensor->width, o.sensor->height);
-            },
-            [](io::ReaderOptions& o, std::optional<std::pair<int, int>> s) {
-                o.sensor = s ? std::optional(SensorSize{s->first, s->second}) : std::nullopt;
-            })
-        .def_property(
-            "fallback_sensor",
-            [](const io::ReaderOptions& o) -> py::object {
-                if (!o.fallback_sensor) return py::none();
-                return py::make_tuple(o.fallback_sensor->width, o.fallback_sensor->height);
-            },
-            [](io::ReaderOptions& o, std::optional<std::pair<int, int>> s) {
-                o.fallback_sensor = s ? std::optional(SensorSize{s->first, s->second}) : std::nullopt;
-            })
+    py::class_<io::ReaderOptions> reader_options(m, "ReaderOptions");
+    reader_options.def(py::init<>());
+    def_size_property<&io::ReaderOptions::sensor>(reader_options, "sensor");
+    def_size_property<&io::ReaderOptions::fallback_sensor>(reader_options, "fallback_sensor");
+    reader_options
         .def_readwrite("skip_invalid", &io::ReaderOptions::skip_invalid)
         .def_readwrite("csv_columns", &io::ReaderOptions::csv_columns)
         .def_readwrite("aedat2_chip", &io::ReaderOptions::aedat2_chip)
