@@ -11,6 +11,8 @@ packages=(
   liblz4-dev libzstd-dev libhdf5-dev hdf5-filter-plugin hdf5-filter-plugin-blosc-serial
   clang libclang-rt-14-dev
   libsqlite3-dev libbz2-dev liblzma-dev libmatio-dev
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-dask python3-distributed
+  python3-venv python3-pip python3-setuptools python3-wheel
 )
 
 missing=()

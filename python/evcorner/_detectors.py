@@ -1,0 +1,99 @@
+"""Detectors (one class per registry entry), one-call detection, evaluation, simulation."""
+
+import os
+
+from . import _evcorner
+from ._evcorner import Detector
+from ._events import _input_path, _size, reader_options
+
+#: The DAVIS240C, the sensor the CLI assumes for formats without one (text, CSV).
+DAVIS240 = (240, 180)
+
+
+def detectors():
+    """Every registered detector, in the registry's order: dicts with name, class_name,
+    summary, has_score, local and params (key, name (the keyword), type, default, min, max, help)."""
+    return _evcorner.detectors()
+
+
+def _make_class(info):
+    name = info["name"]
+    lines = [
+        f"{p['name']}={p['default']!r}  ({p['type']}"
+        + ("" if p["type"] == "true/false" else f", {p['min']:g}..{p['max']:g}")
+        + f"): {p['help']}"
+        for p in info["params"]
+    ]
+
+    def __init__(self, width, height, **params):
+        Detector.__init__(self, name, width, height, params)
+
+    __init__.__doc__ = f"{info['class_name']}(width, height, **params): the '{name}' detector on a width x height sensor."
+    doc = (
+        f"{info['summary']}\n\n"
+        f"Registry name '{name}'. process(events, out=None) -> uint8 mask; state is kept across calls."
+        + (" process_scored(events) -> (mask, scores)." if info["has_score"] else "")
+        + "\n\nKeyword parameters (default, range): "
+        + ("\n    " + "\n    ".join(lines) if lines else "none")
+    )
+    return type(
+        info["class_name"],
+        (Detector,),
+        {"__init__": __init__, "__doc__": doc, "__module__": "evcorner", "registry_name": name},
+    )
+
+
+DETECTOR_CLASSES = {info["class_name"]: _make_class(info) for info in _evcorner.detectors()}
+
+
+def detect(events, detector="efast", sensor=DAVIS240, scores=False, out=None, **params):
+    """Runs `detector` (a registry name) over EVENT_DTYPE `events` in one call, read in
+    place: returns the uint8 mask (1 = corner), or (mask, scores) with scores=True.
+    `sensor` = (width, height), the DAVIS240C's 240x180 by default as in the CLI."""
+    w, h = _size(sensor, "sensor")
+    det = Detector(detector, w, h, params)
+    if scores:
+        return det.process_scored(events, out)
+    return det.process(events, out)
+
+
+def detect_file(input, output=None, detector="efast", mask=None, format="auto", to="auto", with_score=False,
+                threads=1, allow_damaged=False, reader=None, **params):
+    """`evcorner detect` as a function: the library's pipeline from the file `input` to the
+    corner file `output` (None: none) and the mask file `mask` (one 0/1 line per event).
+    `reader`: a dict of reader options (READER_OPTIONS). Returns the summary as the CLI's
+    --summary-json writes it (input, detector, width, height, events, corners, ...)."""
+    return _evcorner.detect_file(
+        _input_path(input),
+        "" if output is None else os.fspath(output),
+        detector,
+        params,
+        reader_options(**(reader or {})),
+        format,
+        to,
+        "" if mask is None else os.fspath(mask),
+        with_score,
+        threads,
+        allow_damaged,
+    )
+
+
+def label(corners, **ft_params):
+    """Feature-track labels of corner events (Mueggler et al. 2017; docs/evaluation.md):
+    returns (on_track uint8 array, dict with corners, on_track, ft_percent, hypotheses,
+    accepted). Keywords: inner_radius, outer_radius, min_inner, max_outer_ratio,
+    max_duration_us, max_length, same_polarity, overlap ("any"/"exclusive"), cell_size."""
+    p = _evcorner.FeatureTrackParams()
+    for key, value in ft_params.items():
+        if key.startswith("_") or not hasattr(p, key):
+            raise TypeError(f"label: unknown parameter {key!r}")
+        setattr(p, key, value)
+    return _evcorner.label(corners, p)
+
+
+def simulate(scene):
+    """Simulates a scene (a JSON file path, or JSON text starting with '{'; docs/simulate.md):
+    returns (events, (width, height))."""
+    if isinstance(scene, str) and scene.lstrip().startswith("{"):
+        return _evcorner.simulate(scene, False)
+    return _evcorner.simulate(_input_path(scene), True)

@@ -1,0 +1,587 @@
+// evcorner._evcorner: the C++ library seen from Python (pybind11). A thin front: every
+// verb here calls the library (registry.hpp, pipeline/detect.hpp, io/, eval/, sim/); the
+// pure-Python parts (python/evcorner/*.py) add keyword parsing, foreign dtypes and Dask.
+//
+// Events cross the border as numpy structured arrays of EVENT_DTYPE, read in place: an
+// array whose dtype, shape, stride or alignment is not exactly that of evcorner::Event is
+// refused with an exception, never copied.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "evcorner/error.hpp"
+#include "evcorner/eval/feature_tracks.hpp"
+#include "evcorner/eval/metrics.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/event_check.hpp"
+#include "evcorner/io/event_reader.hpp"
+#include "evcorner/io/event_writer.hpp"
+#include "evcorner/io/open.hpp"
+#include "evcorner/pipeline/detect.hpp"
+#include "evcorner/registry.hpp"
+#include "evcorner/scored_detector.hpp"
+#include "evcorner/sim/scene.hpp"
+#include "evcorner/sim/simulator.hpp"
+#include "evcorner/state_memory.hpp"
+
+namespace py = pybind11;
+using namespace evcorner;
+
+// EVENT_DTYPE is built from these: numpy reads the C++ struct where it lies.
+static_assert(offsetof(Event, t) == 0 && sizeof(Event::t) == 8);
+static_assert(offsetof(Event, x) == 8 && sizeof(Event::x) == 2);
+static_assert(offsetof(Event, y) == 10 && sizeof(Event::y) == 2);
+static_assert(offsetof(Event, p) == 12 && sizeof(Event::p) == 1);
+static_assert(sizeof(Event) == 16 && alignof(Event) == 8);
+
+namespace {
+
+const py::dtype& event_dtype() {
+    // An aligned struct (align=True): its natural layout is exactly Event's, and numpy keeps
+    // it through concatenate() and friends (a packed dtype would lose the padding: 13 bytes).
+    // Leaked on purpose: destroyed after the interpreter would be too late.
+    static const py::dtype* d = [] {
+        py::dict spec;
+        spec["names"] = py::make_tuple("t", "x", "y", "p");
+        spec["formats"] = py::make_tuple("<i8", "<u2", "<u2", "u1");
+        spec["offsets"] = py::make_tuple(offsetof(Event, t), offsetof(Event, x), offsetof(Event, y), offsetof(Event, p));
+        spec["itemsize"] = sizeof(Event);
+        return new py::dtype(py::module_::import("numpy").attr("dtype")(spec, py::arg("align") = true));
+    }();
+    return *d;
+}
+
+std::string text_of(py::handle h) { return std::string(py::str(h)); }
+
+std::string type_name(py::handle h) { return py::str(py::type::handle_of(h).attr("__name__")); }
+
+/// The events of `obj` in place, or an exception saying why not.
+std::span<const Event> events_view(py::handle obj, const char* what = "events") {
+    if (!py::isinstance<py::array>(obj))
+        throw py::type_error(std::string(what) + ": expected a numpy array of evcorner.EVENT_DTYPE, got " +
+                             type_name(obj));
+    const auto a = py::reinterpret_borrow<py::array>(obj);
+    const py::dtype dt = a.dtype();
+    if (dt.ptr() != event_dtype().ptr()) {
+        const int same = PyObject_RichCompareBool(dt.ptr(), event_dtype().ptr(), Py_EQ);
+        if (same < 0) throw py::error_already_set();
+        if (same == 0)
+            throw py::type_error(std::string(what) + ": dtype " + text_of(dt) +
+                                 " is not evcorner.EVENT_DTYPE " + text_of(event_dtype()) +
+                                 "; convert it with evcorner.as_events(array) (one copy)");
+    }
+    if (a.ndim() != 1)
+        throw py::value_error(std::string(what) + ": expected a 1-D array, got " + std::to_string(a.ndim()) +
+                              " dimensions");
+    const auto n = static_cast<std::size_t>(a.shape(0));
+    if (n > 1 && a.strides(0) != static_cast<py::ssize_t>(sizeof(Event)))
+        throw py::value_error(std::string(what) + ": the array is strided (" + std::to_string(a.strides(0)) +
+                              " bytes between events, 16 expected); evcorner reads arrays in place and does not "
+                              "copy silently: pass numpy.ascontiguousarray(events)");
+    if (reinterpret_cast<std::uintptr_t>(a.data()) % alignof(Event) != 0)
+        throw py::value_error(std::string(what) + ": the array's data is not 8-byte aligned; pass numpy.copy(events)");
+    return {static_cast<const Event*>(a.data()), n};
+}
+
+/// A 1-D contiguous writable array of T with at least n elements (returned as its first n),
+/// or a new one when `out` is None.
+template <class T>
+py::array_t<T> output_array(py::handle out, std::size_t n, const char* what) {
+    if (out.is_none()) return py::array_t<T>(static_cast<py::ssize_t>(n));
+    if (!py::isinstance<py::array>(out))
+        throw py::type_error(std::string(what) + ": expected a numpy array, got " + type_name(out));
+    auto a = py::reinterpret_borrow<py::array>(out);
+    const py::dtype want = py::dtype::of<T>();
+    if (PyObject_RichCompareBool(a.dtype().ptr(), want.ptr(), Py_EQ) != 1)
+        throw py::type_error(std::string(what) + ": dtype " + text_of(a.dtype()) + " is not " +
+                             text_of(want));
+    if (a.ndim() != 1 || (a.shape(0) > 1 && a.strides(0) != static_cast<py::ssize_t>(sizeof(T))))
+        throw py::value_error(std::string(what) + ": expected a 1-D contiguous array");
+    if (!a.writeable()) throw py::value_error(std::string(what) + ": the array is read-only");
+    if (static_cast<std::size_t>(a.shape(0)) < n)
+        throw py::value_error(std::string(what) + ": " + std::to_string(a.shape(0)) + " elements for " +
+                              std::to_string(n) + " events");
+    if (static_cast<std::size_t>(a.shape(0)) == n) return py::reinterpret_borrow<py::array_t<T>>(out);
+    return py::reinterpret_steal<py::array_t<T>>(
+        PySequence_GetSlice(out.ptr(), 0, static_cast<Py_ssize_t>(n)));
+}
+
+/// Hands a vector of events to numpy without copying it.
+py::array to_array(std::vector<Event>&& v) {
+    auto* owner = new std::vector<Event>(std::move(v));
+    py::capsule free_when_done(owner, [](void* p) { delete static_cast<std::vector<Event>*>(p); });
+    return py::array(event_dtype(), {static_cast<py::ssize_t>(owner->size())},
+                     {static_cast<py::ssize_t>(sizeof(Event))}, owner->data(), free_when_done);
+}
+
+/// Keyword arguments (harris_window=11) as registry values ("harris-window" = 11).
+ParamValues params_from(const py::dict& kw) {
+    ParamValues values;
+    for (const auto& [k, v] : kw) {
+        const std::string id = py::str(k);
+        const std::string tname = type_name(v);
+        if (tname == "bool" || tname == "bool_")
+            values.set(param_key(id), v.cast<bool>());
+        else if (PyFloat_Check(v.ptr()) || tname.rfind("float", 0) == 0)
+            values.set(param_key(id), v.cast<double>());
+        else if (PyIndex_Check(v.ptr()))
+            values.set(param_key(id), v.cast<std::int64_t>());
+        else
+            throw py::type_error(id + ": expected an int, float or bool, got " + tname);
+    }
+    return values;
+}
+
+/// A registry message with keys spelt as Python keywords ("harris-window" -> "harris_window").
+std::string pythonic(std::string message) {
+    std::vector<std::string_view> keys;
+    for (const DetectorInfo& info : detector_infos())
+        for (const ParamInfo& p : info.params) keys.push_back(p.key);
+    std::sort(keys.begin(), keys.end(), [](auto a, auto b) { return a.size() > b.size(); });
+    for (const std::string_view key : keys) {
+        const std::string id = [&] {
+            std::string s(key);
+            std::replace(s.begin(), s.end(), '-', '_');
+            return s;
+        }();
+        for (std::size_t at = message.find(key); at != std::string::npos; at = message.find(key, at + id.size()))
+            message.replace(at, key.size(), id);
+    }
+    return message;
+}
+
+template <class F>
+decltype(auto) pythonic_errors(F&& f) {
+    try {
+        return f();
+    } catch (const InvalidEvent&) {
+        throw;
+    } catch (const std::invalid_argument& e) {
+        throw py::value_error(pythonic(e.what()));
+    }
+}
+
+/// The C++ class name of D ("EFast"), from the compiler: the Python class takes it.
+template <class T>
+std::string cpp_class_name() {
+    const std::string_view f = __PRETTY_FUNCTION__;  // "... [with T = evcorner::EFast; ...]" (GCC) / "[T = ...]"
+    const auto b = f.find("T = ");
+    if (b == std::string_view::npos) return {};
+    std::string_view s = f.substr(b + 4);
+    s = s.substr(0, s.find_first_of(";]"));
+    if (const auto c = s.rfind("::"); c != std::string_view::npos) s = s.substr(c + 2);
+    return std::string(s);
+}
+
+/// (width, height), or None.
+py::object size_or_none(const std::optional<SensorSize>& s) {
+    if (!s) return py::none();
+    return py::make_tuple(s->width, s->height);
+}
+
+/// A ReaderOptions size field as a Python property: (width, height) or None.
+template <auto Member>
+void def_size_property(py::class_<io::ReaderOptions>& c, const char* name) {
+    c.def_property(
+        name, [](const io::ReaderOptions& o) { return size_or_none(o.*Member); },
+        [](io::ReaderOptions& o, std::optional<std::pair<int, int>> s) {
+            o.*Member = s ? std::optional(SensorSize{s->first, s->second}) : std::nullopt;
+        });
+}
+
+SensorSize sensor_of(int width, int height) { return SensorSize{width, height}; }
+
+/// One registered detector, stateful across calls.
+class PyDetector {
+public:
+    PyDetector(std::string name, int width, int height, const py::dict& params)
+        : config_{std::move(name), params_from(params)},
+          size_(sensor_of(width, height)),
+          det_(pythonic_errors([&] { return make_detector(config_, size_); })) {}
+
+    py::object process(py::handle events, py::handle out) {
+        const std::span<const Event> ev = events_view(events);
+        py::array_t<std::uint8_t> mask = output_array<std::uint8_t>(out, ev.size(), "out");
+        const std::span<std::uint8_t> flags(mask.mutable_data(), ev.size());
+        std::size_t corners = 0;
+        {
+            py::gil_scoped_release release;
+            const std::lock_guard lock(mutex_);
+            corners = detect(det_, ev, flags);
+            count(ev, corners);
+        }
+        return mask;
+    }
+
+    py::tuple process_scored(py::handle events, py::handle out, py::handle scores_out) {
+        if (!has_score(det_))
+            throw py::type_error("detector '" + config_.name + "' has no score (see evcorner.detectors())");
+        const std::span<const Event> ev = events_view(events);
+        py::array_t<std::uint8_t> mask = output_array<std::uint8_t>(out, ev.size(), "out");
+        py::array_t<double> scores = output_array<double>(scores_out, ev.size(), "scores");
+        const std::span<std::uint8_t> flags(mask.mutable_data(), ev.size());
+        const std::span<double> sc(scores.mutable_data(), ev.size());
+        {
+            py::gil_scoped_release release;
+            const std::lock_guard lock(mutex_);
+            const std::size_t corners = std::visit(
+                [&](auto& d) -> std::size_t {
+                    if constexpr (ScoredDetector<std::remove_cvref_t<decltype(d)>>)
+                        return detect(d, ev, flags, sc);
+                    else
+                        return 0;  // unreachable: has_score() said so
+                },
+                det_);
+            count(ev, corners);
+        }
+        return py::make_tuple(std::move(mask), std::move(scores));
+    }
+
+    void reset() {
+        const std::lock_guard lock(mutex_);
+        det_ = make_detector(config_, size_);
+        events_ = corners_ = 0;
+        last_address_ = 0;
+    }
+
+    [[nodiscard]] std::string name() const { return config_.name; }
+    [[nodiscard]] py::tuple sensor() const { return py::make_tuple(size_.width, size_.height); }
+    [[nodiscard]] bool scored() const { return has_score(det_); }
+    [[nodiscard]] std::size_t memory() const { return memory_bytes(det_); }
+    [[nodiscard]] py::dict params() const {
+        py::dict d;
+        for (const auto& [key, value] : config_.params) {
+            std::string id = key;
+            std::replace(id.begin(), id.end(), '-', '_');
+            std::visit([&](auto v) { d[py::str(id)] = v; }, value);
+        }
+        return d;
+    }
+    std::uint64_t events_ = 0, corners_ = 0;
+    std::uintptr_t last_address_ = 0;  ///< where the last call read its events (the zero-copy test)
+
+private:
+    void count(std::span<const Event> ev, std::size_t corners) {
+        events_ += ev.size();
+        corners_ += corners;
+        last_address_ = reinterpret_cast<std::uintptr_t>(ev.data());
+    }
+
+    DetectorConfig config_;
+    SensorSize size_;
+    AnyDetector det_;
+    std::mutex mutex_;
+};
+
+/// An open event file, read in chunks (by count or up to a time) in constant memory.
+class PyReader {
+public:
+    PyReader(const std::string& path, const io::ReaderOptions& options, const std::string& format)
+        : reader_(io::open_event_reader(path, options, format)), buf_(std::size_t{1} << 16) {}
+
+    py::array read_count(std::size_t n) {
+        std::vector<Event> out;
+        {
+            py::gil_scoped_release release;
+            out.reserve(std::min<std::size_t>(n, std::size_t{1} << 20));
+            while (out.size() < n && fill()) {
+                const std::size_t take = std::min(n - out.size(), len_ - pos_);
+                out.insert(out.end(), buf_.begin() + pos_, buf_.begin() + pos_ + take);
+                pos_ += take;
+            }
+        }
+        return to_array(std::move(out));
+    }
+
+    /// The events before the first one at or after t_end (file order).
+    py::array read_until(std::int64_t t_end) {
+        std::vector<Event> out;
+        {
+            py::gil_scoped_release release;
+            while (fill()) {
+                std::size_t end = pos_;
+                while (end < len_ && buf_[end].t < t_end) ++end;
+                out.insert(out.end(), buf_.begin() + pos_, buf_.begin() + end);
+                pos_ = end;
+                if (end < len_) break;
+            }
+        }
+        return to_array(std::move(out));
+    }
+
+    /// The time of the next event, or None at the end.
+    py::object peek_time() {
+        bool more = false;
+        {
+            py::gil_scoped_release release;
+            more = fill();
+        }
+        if (!more) return py::none();
+        return py::int_(buf_[pos_].t);
+    }
+
+    [[nodiscard]] py::object sensor() const { return size_or_none(reader_->sensor()); }
+    [[nodiscard]] std::string format() const { return std::string(reader_->format()); }
+    [[nodiscard]] std::string name() const { return reader_->name(); }
+    [[nodiscard]] std::uint64_t skipped() const { return reader_->skipped(); }
+    [[nodiscard]] std::uint64_t bytes_consumed() const { return reader_->bytes_consumed(); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const { return reader_->bytes_total(); }
+
+private:
+    // Makes buf_[pos_] the next event; false at the end.
+    bool fill() {
+        while (pos_ == len_ && !done_) {
+            len_ = reader_->read(buf_);
+            pos_ = 0;
+            if (len_ == 0 && reader_->skipped_in_batch().empty()) done_ = true;
+        }
+        return pos_ < len_;
+    }
+
+    std::unique_ptr<io::EventReader> reader_;
+    std::vector<Event> buf_;
+    std::size_t pos_ = 0, len_ = 0;
+    bool done_ = false;
+};
+
+void write_events(const std::string& path, py::handle events, const std::string& format,
+                  std::optional<std::pair<int, int>> sensor) {
+    const std::span<const Event> ev = events_view(events);
+    py::gil_scoped_release release;
+    std::optional<SensorSize> size;
+    if (sensor) size = SensorSize{sensor->first, sensor->second};
+    auto writer = io::open_event_writer(path, format, size);
+    writer->write(ev);
+    writer->close();
+}
+
+py::dict summary_dict(const pipeline::DetectSummary& s, const std::string& input, const py::dict& params) {
+    py::dict d;
+    d["input"] = input;
+    d["detector"] = s.detector;
+    d["width"] = s.sensor.width;
+    d["height"] = s.sensor.height;
+    d["events"] = s.events;
+    d["corners"] = s.corners;
+    d["skipped"] = s.skipped;
+    d["reduction_rate"] = s.events ? py::object(py::float_(s.reduction_percent())) : py::object(py::none());
+    d["ns_per_event"] = s.events ? py::object(py::float_(s.ns_per_event())) : py::object(py::none());
+    d["threads"] = s.threads;
+    d["detect_s"] = s.detect_s;
+    d["wall_s"] = s.wall_s;
+    d["damaged"] = s.damaged.empty() ? py::object(py::none()) : py::object(py::str(s.damaged));
+    d["params"] = params;
+    return d;
+}
+
+py::dict detect_file_py(const std::string& input, const std::string& output, const std::string& detector,
+                        const py::dict& params, const io::ReaderOptions& reader, const std::string& format,
+                        const std::string& to, const std::string& mask, bool with_score, int threads,
+                        bool allow_damaged) {
+    pipeline::DetectFiles files;
+    files.input = input;
+    files.format = format;
+    files.reader = reader;
+    files.output = output;
+    files.to = to;
+    files.mask = mask;
+    pipeline::DetectOptions options;
+    options.detector = DetectorConfig{detector, params_from(params)};
+    options.with_score = with_score;
+    options.threads = threads;
+    options.allow_damaged = allow_damaged;
+    const pipeline::DetectSummary s = pythonic_errors([&] {
+        pipeline::check_detect_options(options);
+        py::gil_scoped_release release;
+        return pipeline::detect_file(files, options);
+    });
+    return summary_dict(s, input, params);
+}
+
+py::list detector_list() {
+    std::vector<std::pair<std::string, std::string>> classes;
+    for_each_detector_entry([&](const auto& e) {
+        using D = typename std::remove_cvref_t<decltype(e)>::Detector;
+        classes.emplace_back(std::string(e.name), cpp_class_name<D>());
+    });
+    py::list out;
+    for (const DetectorInfo& info : detector_infos()) {
+        py::dict d;
+        d["name"] = std::string(info.name);
+        for (const auto& [n, c] : classes)
+            if (n == info.name) d["class_name"] = c;
+        d["summary"] = std::string(info.summary);
+        d["has_score"] = info.has_score;
+        d["local"] = info.local();
+        py::list params;
+        for (const ParamInfo& p : info.params) {
+            py::dict q;
+            std::string id(p.key);
+            std::replace(id.begin(), id.end(), '-', '_');
+            q["key"] = std::string(p.key);
+            q["name"] = id;
+            q["type"] = std::string(param_type_name(p.type));
+            std::visit([&](auto v) { q["default"] = v; }, p.default_value);
+            q["min"] = p.min;
+            q["max"] = p.max;
+            q["help"] = std::string(p.help);
+            params.append(q);
+        }
+        d["params"] = params;
+        out.append(d);
+    }
+    return out;
+}
+
+py::tuple label_py(py::handle corners, const eval::FeatureTrackParams& params) {
+    const std::span<const Event> ev = events_view(corners, "corners");
+    eval::FeatureTrackResult r;
+    {
+        py::gil_scoped_release release;
+        eval::validate(params);
+        r = eval::label_feature_tracks(ev, params);
+    }
+    py::array_t<std::uint8_t> on_track(static_cast<py::ssize_t>(r.on_track.size()));
+    std::copy(r.on_track.begin(), r.on_track.end(), on_track.mutable_data());
+    py::dict info;
+    info["corners"] = r.on_track.size();
+    info["on_track"] = r.labelled;
+    info["ft_percent"] = r.ft_percent();
+    info["hypotheses"] = r.hypotheses;
+    info["accepted"] = r.accepted;
+    return py::make_tuple(std::move(on_track), info);
+}
+
+py::tuple simulate_py(const std::string& scene, bool is_path) {
+    std::vector<Event> events;
+    SensorSize size;
+    {
+        py::gil_scoped_release release;
+        const sim::Scene s = is_path ? sim::load_scene_file(scene) : sim::parse_scene(scene, "<scene>");
+        size = s.sensor;
+        events = sim::simulate(s);
+    }
+    return py::make_tuple(to_array(std::move(events)), py::make_tuple(size.width, size.height));
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_evcorner, m) {
+    m.doc() = "evcorner's C++ library (see the evcorner package for the documented API)";
+
+    static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+    static py::exception<OutputError> output_error(m, "OutputError", PyExc_OSError);
+    static py::exception<InvalidEvent> invalid_event(m, "InvalidEvent", PyExc_ValueError);
+    static py::exception<StateTooLarge> too_large(m, "StateTooLarge", PyExc_MemoryError);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const InputError& e) {
+            input_error(e.what());
+        } catch (const OutputError& e) {
+            output_error(e.what());
+        } catch (const InvalidEvent& e) {
+            invalid_event(e.what());
+        } catch (const StateTooLarge& e) {
+            too_large(e.what());
+        }
+    });
+
+    m.attr("EVENT_DTYPE") = event_dtype();
+    m.def("_event_layout", [] {
+        return py::dict(py::arg("itemsize") = sizeof(Event), py::arg("t") = offsetof(Event, t),
+                        py::arg("x") = offsetof(Event, x), py::arg("y") = offsetof(Event, y),
+                        py::arg("p") = offsetof(Event, p));
+    });
+    m.def("_address", [](py::handle events) { return reinterpret_cast<std::uintptr_t>(events_view(events).data()); },
+          "Where C++ reads the events of an array (checked as every verb checks it).");
+    m.def("detectors", &detector_list, "Every registered detector: name, class_name, summary, has_score, params.");
+    m.attr("INPUT_FORMATS") = std::string(io::kInputFormats);
+    m.attr("OUTPUT_FORMATS") = std::string(io::kOutputFormats);
+
+    py::class_<PyDetector>(m, "Detector")
+        .def(py::init<std::string, int, int, py::dict>(), py::arg("name"), py::arg("width"), py::arg("height"),
+             py::arg("params"))
+        .def("process", &PyDetector::process, py::arg("events"), py::arg("out") = py::none())
+        .def("process_scored", &PyDetector::process_scored, py::arg("events"), py::arg("out") = py::none(),
+             py::arg("scores") = py::none())
+        .def("reset", &PyDetector::reset)
+        .def_property_readonly("name", &PyDetector::name)
+        .def_property_readonly("sensor", &PyDetector::sensor)
+        .def_property_readonly("has_score", &PyDetector::scored)
+        .def_property_readonly("memory_bytes", &PyDetector::memory)
+        .def_property_readonly("params", &PyDetector::params)
+        .def_readonly("events", &PyDetector::events_)
+        .def_readonly("corners", &PyDetector::corners_)
+        .def_readonly("last_address", &PyDetector::last_address_);
+
+    py::class_<io::ReaderOptions> reader_options(m, "ReaderOptions");
+    reader_options.def(py::init<>());
+    def_size_property<&io::ReaderOptions::sensor>(reader_options, "sensor");
+    def_size_property<&io::ReaderOptions::fallback_sensor>(reader_options, "fallback_sensor");
+    reader_options
+        .def_readwrite("skip_invalid", &io::ReaderOptions::skip_invalid)
+        .def_readwrite("csv_columns", &io::ReaderOptions::csv_columns)
+        .def_readwrite("aedat2_chip", &io::ReaderOptions::aedat2_chip)
+        .def_readwrite("time_unit", &io::ReaderOptions::csv_time_unit)
+        .def_readwrite("npy_columns", &io::ReaderOptions::npy_columns)
+        .def_readwrite("mat_var", &io::ReaderOptions::mat_var)
+        .def_readwrite("mat_columns", &io::ReaderOptions::mat_columns)
+        .def_readwrite("topic", &io::ReaderOptions::topic);
+
+    py::class_<PyReader>(m, "Reader")
+        .def(py::init<const std::string&, const io::ReaderOptions&, const std::string&>(), py::arg("path"),
+             py::arg("options"), py::arg("format") = "auto")
+        .def("read_count", &PyReader::read_count, py::arg("n"))
+        .def("read_until", &PyReader::read_until, py::arg("t_end"))
+        .def("peek_time", &PyReader::peek_time)
+        .def_property_readonly("sensor", &PyReader::sensor)
+        .def_property_readonly("format", &PyReader::format)
+        .def_property_readonly("name", &PyReader::name)
+        .def_property_readonly("skipped", &PyReader::skipped)
+        .def_property_readonly("bytes_consumed", &PyReader::bytes_consumed)
+        .def_property_readonly("bytes_total", &PyReader::bytes_total);
+
+    m.def("write", &write_events, py::arg("path"), py::arg("events"), py::arg("format") = "auto",
+          py::arg("sensor") = py::none());
+    m.def("detect_file", &detect_file_py, py::arg("input"), py::arg("output"), py::arg("detector"),
+          py::arg("params"), py::arg("reader"), py::arg("format") = "auto", py::arg("to") = "auto",
+          py::arg("mask") = "", py::arg("with_score") = false, py::arg("threads") = 1,
+          py::arg("allow_damaged") = false);
+
+    py::class_<eval::FeatureTrackParams>(m, "FeatureTrackParams")
+        .def(py::init<>())
+        .def_readwrite("inner_radius", &eval::FeatureTrackParams::inner_radius)
+        .def_readwrite("outer_radius", &eval::FeatureTrackParams::outer_radius)
+        .def_readwrite("min_inner", &eval::FeatureTrackParams::min_inner)
+        .def_readwrite("max_outer_ratio", &eval::FeatureTrackParams::max_outer_ratio)
+        .def_readwrite("max_duration_us", &eval::FeatureTrackParams::max_duration_us)
+        .def_readwrite("max_length", &eval::FeatureTrackParams::max_length)
+        .def_readwrite("same_polarity", &eval::FeatureTrackParams::same_polarity)
+        .def_property(
+            "overlap", [](const eval::FeatureTrackParams& p) { return std::string(eval::to_string(p.overlap)); },
+            [](eval::FeatureTrackParams& p, const std::string& s) {
+                pythonic_errors([&] { p.overlap = eval::parse_track_overlap(s); });
+            })
+        .def_readwrite("cell_size", &eval::FeatureTrackParams::cell_size);
+    m.def("label", [](py::handle corners, const eval::FeatureTrackParams& p) {
+        return pythonic_errors([&] { return label_py(corners, p); });
+    });
+    m.def("reduction_rate", &eval::reduction_rate, py::arg("events"), py::arg("corners"));
+    m.def("ft_percent", &eval::ft_percent, py::arg("corners"), py::arg("on_track"));
+    m.def("simulate", &simulate_py, py::arg("scene"), py::arg("is_path"));
+}

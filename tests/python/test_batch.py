@@ -1,0 +1,201 @@
+"""Batches on Dask distributed: a LocalCluster of 2 workers, an external scheduler with two
+`dask worker` processes on 127.0.0.1, failures, and resuming an interrupted batch."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import evcorner
+from conftest import SAMPLE
+
+distributed = pytest.importorskip("distributed")
+from evcorner import batch  # noqa: E402
+
+DETECTORS = ["efast", "harris"]
+
+
+def env_with_package():
+    env = dict(os.environ)
+    pkg_root = str(Path(evcorner.__file__).resolve().parent.parent)
+    env["PYTHONPATH"] = pkg_root + os.pathsep + env.get("PYTHONPATH", "")
+    return env
+
+
+@pytest.fixture(scope="module")
+def recordings(tmp_path_factory):
+    """Three recordings cut from the bundled sample, plus the sample itself."""
+    d = tmp_path_factory.mktemp("recordings")
+    events = evcorner.read(SAMPLE)
+    paths = [str(SAMPLE)]
+    for i, (a, b) in enumerate([(0, 9000), (9000, 21000), (21000, 30000)]):
+        p = d / f"part{i}.txt"
+        evcorner.write(p, events[a:b])
+        paths.append(str(p))
+    return paths
+
+
+@pytest.fixture(scope="module")
+def cli_counts(recordings, tmp_path_factory):
+    cli = os.environ.get("EVCORNER_CLI") or str(Path(SAMPLE).parents[3] / "build" / "bin" / "evcorner")
+    if not Path(cli).exists():
+        pytest.skip("the evcorner CLI is not built")
+    d = tmp_path_factory.mktemp("cli")
+    counts = {}
+    for i, path in enumerate(recordings):
+        for det in DETECTORS:
+            js = d / f"{i}-{det}.json"
+            subprocess.run([cli, "detect", path, "-d", det, "-o", os.devnull, "--summary-json", str(js), "-q"],
+                           check=True)
+            counts[(path, det)] = json.loads(js.read_text())["corners"]
+    return counts
+
+
+@pytest.fixture(scope="module")
+def client():
+    from dask.distributed import Client, LocalCluster
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def lines(path):
+    return [json.loads(x) for x in Path(path).read_text().splitlines()]
+
+
+def test_local_cluster_counts_equal_the_cli(client, recordings, cli_counts, tmp_path):
+    tasks = batch.plan(recordings, DETECTORS, tmp_path)
+    assert len(tasks) == len(recordings) * len(DETECTORS)
+    futures = batch.submit(client, tasks)
+    assert len(futures) == len(tasks) and all(isinstance(f, distributed.Future) for f in futures.values())
+    records = batch.gather(tasks, futures, tmp_path)
+    workers = set(client.run(os.getpid).values())
+    for t, r in zip(tasks, records):
+        assert r["status"] == "ok", r
+        assert r["corners"] == cli_counts[(t["input"], t["detector"])]
+        assert r["pid"] in workers and r["pid"] != os.getpid()
+        assert len(Path(t["corners"]).read_text().splitlines()) == r["corners"]
+        assert json.loads(Path(t["summary"]).read_text())["corners"] == r["corners"]
+    assert sorted(x["task"] for x in lines(tmp_path / "results.jsonl")) == sorted(t["key"] for t in tasks)
+
+
+def test_parameter_grid_and_a_failure_do_not_stop_the_others(client, recordings, tmp_path):
+    damaged = tmp_path / "damaged.txt"
+    damaged.write_text("0.000001 1 2 1\nnot an event\n")
+    inputs = [recordings[1], str(damaged), str(tmp_path / "missing.txt")]
+    records = batch.run(client, inputs, ["harris"], tmp_path / "out", params={"harris_window": [5, 7]})
+    assert len(records) == 6
+    ok = [r for r in records if r["status"] == "ok"]
+    failed = [r for r in records if r["status"] != "ok"]
+    assert len(ok) == 2 and {r["params"]["harris_window"] for r in ok} == {5, 7}
+    assert ok[0]["corners"] != ok[1]["corners"]
+    assert len(failed) == 4
+    assert all("damaged.txt:2" in r["error"] for r in failed if r["input"] == str(damaged))
+    assert all("FileNotFoundError" in r["error"] for r in failed if r["input"].endswith("missing.txt"))
+    assert "FAILED" in batch.table(records)
+
+
+def test_resume_skips_what_was_done(client, recordings, cli_counts, tmp_path):
+    tasks = batch.plan(recordings, DETECTORS, tmp_path)
+    # An interrupted batch: only the first three tasks ran.
+    batch.gather(tasks[:3], batch.submit(client, tasks[:3]), tmp_path)
+    stamps = {t["key"]: os.stat(t["summary"]).st_mtime_ns for t in tasks[:3]}
+    futures = batch.submit(client, tasks)
+    assert set(futures) == {t["key"] for t in tasks[3:]}
+    records = batch.gather(tasks, futures, tmp_path)
+    assert [bool(r.get("resumed")) for r in records] == [True] * 3 + [False] * (len(tasks) - 3)
+    for t, r in zip(tasks, records):
+        assert r["corners"] == cli_counts[(t["input"], t["detector"])]
+    assert {t["key"]: os.stat(t["summary"]).st_mtime_ns for t in tasks[:3]} == stamps
+    logged = [x["task"] for x in lines(tmp_path / "results.jsonl")]
+    assert sorted(logged) == sorted(t["key"] for t in tasks)  # each once
+
+
+def test_cli_interrupted_then_resumed(recordings, cli_counts, tmp_path):
+    """Interrupts `python3 -m evcorner batch` (SIGINT) once a result is logged, then reruns it."""
+    out = tmp_path / "out"
+    inputs = recordings * 1
+    cmd = [sys.executable, "-m", "evcorner", "batch", *inputs, "-d", ",".join(DETECTORS), "-o", str(out),
+           "--workers", "1", "-p", "harris_window=5,7,9"]
+    proc = subprocess.Popen(cmd, env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            start_new_session=True)
+    log = out / "results.jsonl"
+    deadline = time.time() + 60
+    while time.time() < deadline and proc.poll() is None:
+        if log.exists() and log.read_text().count("\n") >= 1:
+            break
+        time.sleep(0.02)
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGINT)
+    try:
+        proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    total = len(recordings) * (1 + 3)
+    done_before = len(list(out.rglob("*.json")))
+    assert 1 <= done_before <= total
+    rerun = subprocess.run(cmd, env=env_with_package(), capture_output=True, text=True, timeout=120)
+    assert rerun.returncode == 0, rerun.stderr
+    assert f"({done_before} done before)" in rerun.stderr
+    assert rerun.stdout.count("ok (resumed)") == done_before
+    for r in lines(log):
+        if r["detector"] == "efast":
+            assert r["corners"] == cli_counts[(r["input"], "efast")]
+    assert len({r["task"] for r in lines(log)}) == total
+
+
+def test_external_scheduler_and_two_dask_workers(recordings, cli_counts, tmp_path):
+    """`dask scheduler` + two `dask worker` processes on 127.0.0.1, all stopped at the end."""
+    sched_file = tmp_path / "scheduler.json"
+    env = env_with_package()
+    dask = [sys.executable, "-m", "dask", "scheduler"]  # the `dask` command, on this interpreter
+    worker = [sys.executable, "-m", "dask", "worker"]
+    procs = []
+    try:
+        procs.append(subprocess.Popen(dask + ["--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                                              "--scheduler-file", str(sched_file)],
+                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        deadline = time.time() + 60
+        while not sched_file.exists() and time.time() < deadline:
+            time.sleep(0.05)
+        for i in range(2):
+            procs.append(subprocess.Popen(worker + ["--scheduler-file", str(sched_file), "--nthreads", "1",
+                                                    "--no-nanny", "--no-dashboard", "--name", f"w{i}",
+                                                    "--host", "127.0.0.1"],
+                                          env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        from dask.distributed import Client
+        with Client(scheduler_file=str(sched_file), timeout=60) as c:
+            c.wait_for_workers(2, timeout=60)
+        out = tmp_path / "out"
+        r = subprocess.run([sys.executable, "-m", "evcorner", "batch", *recordings, "-d", ",".join(DETECTORS),
+                            "-o", str(out), "--scheduler-file", str(sched_file)],
+                           env=env, capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr
+        assert "on 2 workers" in r.stderr
+        assert r.stdout.splitlines()[0].split()[:2] == ["recording", "detector+params"]
+        results = lines(out / "results.jsonl")
+        assert len(results) == len(recordings) * len(DETECTORS)
+        worker_pids = {p.pid for p in procs[1:]}
+        for x in results:
+            assert x["status"] == "ok" and x["pid"] in worker_pids
+            assert x["corners"] == cli_counts[(x["input"], x["detector"])]
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+    assert all(p.poll() is not None for p in procs)
