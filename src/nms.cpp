@@ -64,12 +64,12 @@ bool AsyncNms::keep(const Event& e, double score) noexcept {
                 }
                 // Beyond 700 time constants the weight is 0 (below the normal doubles,
                 // where exp() is slow): the decayed score is 0, or -infinity for sc < 0.
-                const double x = static_cast<double>(dt) * inv_time_;
+                const double ages = static_cast<double>(dt) * inv_time_;
                 double d;
-                if (x > 700.0) {
+                if (ages > 700.0) {
                     d = c.score >= 0 ? 0.0 : -std::numeric_limits<double>::infinity();
                 } else {
-                    const double w = std::exp(-x);
+                    const double w = std::exp(-ages);
                     d = c.score >= 0 ? c.score * w : c.score / w;
                 }
                 suppressed = d >= s;
