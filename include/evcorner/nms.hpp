@@ -174,19 +174,6 @@ std::size_t detect_unchecked(Suppressed<D>& det, std::span<const Event> events,
     }
     return detect_unchecked(det, events, is_corner, score);
 }
-template <ScoredDetector D>
-std::size_t detect(Suppressed<D>& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
-    detail::check_flags(events.size(), is_corner.size(), "detect");
-    check_events(events, det.limits());
-    return detect_unchecked(det, events, is_corner);
-}
-template <ScoredDetector D>
-std::size_t detect(Suppressed<D>& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
-                   std::span<double> score) {
-    detail::check_flags(events.size(), is_corner.size(), "detect");
-    detail::check_flags(events.size(), score.size(), "detect (scores)");
-    check_events(events, det.limits());
-    return detect_unchecked(det, events, is_corner, score);
-}
+// The checked detect() of detector.hpp and scored_detector.hpp find these loops.
 
 }  // namespace evcorner
