@@ -79,6 +79,41 @@ std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::u
     return loop()(det, events, is_corner);
 }
 
+namespace {
+std::size_t scored_portable(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                            std::span<double> score) noexcept {
+    return det.run_scored_unchecked<ScalarSearch>(events, is_corner, score);
+}
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+[[gnu::target("avx2"), gnu::flatten]] std::size_t scored_avx2(ArcStar& det, std::span<const Event> events,
+                                                               std::span<std::uint8_t> is_corner,
+                                                               std::span<double> score) noexcept {
+    return det.run_scored_unchecked<Avx2Search>(events, is_corner, score);
+}
+#endif
+// The scored loop beside the chosen binary path: AVX2 where the CPU runs it.
+std::size_t scored_loop(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                        std::span<double> score) noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    if (std::strcmp(path().name, "portable") != 0) return scored_avx2(det, events, is_corner, score);
+#endif
+    return scored_portable(det, events, is_corner, score);
+}
+}  // namespace
+
+std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                   std::span<double> score) {
+    detail::check_flags(events.size(), is_corner.size(), "detect");
+    detail::check_flags(events.size(), score.size(), "detect (scores)");
+    check_events(events, det.limits());
+    return scored_loop(det, events, is_corner, score);
+}
+
+std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             std::span<double> score) noexcept {
+    return scored_loop(det, events, is_corner, score);
+}
+
 const char* arcstar_code_path() noexcept { return path().name; }
 
 std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {

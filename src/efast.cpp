@@ -33,6 +33,32 @@ std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span
 
 using Loop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
 
+// The scored loops (detect with scores), one per path, beside the binary ones.
+using ScoredLoop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>, std::span<double>) noexcept;
+std::size_t scored_portable(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                            std::span<double> score) noexcept {
+    return det.run_scored_unchecked<ScalarSearch>(events, is_corner, score);
+}
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+[[gnu::target("avx2"), gnu::flatten]] std::size_t scored_avx2(EFast& det, std::span<const Event> events,
+                                                               std::span<std::uint8_t> is_corner,
+                                                               std::span<double> score) noexcept {
+    return det.run_scored_unchecked<Avx2Search>(events, is_corner, score);
+}
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t scored_avx512(
+    EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner, std::span<double> score) noexcept {
+    return det.run_scored_unchecked<Avx512Search>(events, is_corner, score);
+}
+#endif
+ScoredLoop scored_loop_of(Loop loop) noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    if (loop == detect_avx512) return scored_avx512;
+    if (loop == detect_avx2) return scored_avx2;
+#endif
+    (void)loop;
+    return scored_portable;
+}
+
 struct Path {
     const char* name;
     Loop loop;
@@ -78,6 +104,19 @@ std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uin
 
 std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
     return choice().loop(det, events, is_corner);
+}
+
+std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                   std::span<double> score) {
+    detail::check_flags(events.size(), is_corner.size(), "detect");
+    detail::check_flags(events.size(), score.size(), "detect (scores)");
+    check_events(events, det.limits());
+    return scored_loop_of(choice().loop)(det, events, is_corner, score);
+}
+
+std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             std::span<double> score) noexcept {
+    return scored_loop_of(choice().loop)(det, events, is_corner, score);
 }
 
 const char* efast_code_path() noexcept { return choice().name; }

@@ -163,8 +163,11 @@ TEST_F(Pipeline, OptionsAreCheckedBeforeReading) {
     };
     pipeline::DetectOptions o;
     EXPECT_EQ(message(o), "(accepted)");
-    o.with_score = true;
-    EXPECT_NE(message(o).find("has no score"), std::string::npos);
+    o.with_score = true;  // every detector has a score (docs/scores.md), on one thread
+    EXPECT_EQ(message(o), "(accepted)");
+    o.threads = 2;
+    EXPECT_NE(message(o).find("needs one thread"), std::string::npos);
+    o.threads = 1;
     o.with_score = false;
     o.detector.name = "harris-global";
     o.threads = 2;

@@ -38,6 +38,9 @@ struct DetectOptions {
     std::string size;
     std::string summary_json;
     bool skip_invalid = false;
+    bool nms = false;
+    NmsParams nms_params;
+    std::string nms_rule = "window";
     bool quiet = false;
     bool no_progress = false;
 };
@@ -50,6 +53,10 @@ void print_summary(const DetectOptions& o, const pipeline::DetectSummary& t) {
     fmt::print(stderr, "  detector     {}{} on a {}x{} sensor\n", t.detector, params, t.sensor.width, t.sensor.height);
     fmt::print(stderr, "  events       {}\n", t.events);
     if (t.skipped > 0) fmt::print(stderr, "  skipped      {} (outside the sensor)\n", t.skipped);
+    if (o.run.nms)
+        fmt::print(stderr, "  nms          rule {}, radius {} px, {} {} us (the corners below are the kept ones)\n",
+                   nms_rule_name(o.run.nms->rule), o.run.nms->radius,
+                   o.run.nms->rule == NmsRule::window ? "window" : "decay", o.run.nms->time_us);
     fmt::print(stderr, "  corners      {}\n", t.corners);
     if (t.events > 0) {
         fmt::print(stderr, "  reduction    {:.2f} % of events removed\n", t.reduction_percent());
@@ -89,6 +96,10 @@ void write_summary_json(const DetectOptions& o, const pipeline::DetectSummary& t
         j["ns_per_event"] = nullptr;
     }
     j["threads"] = t.threads;
+    if (o.run.nms)
+        j["nms"] = {{"rule", nms_rule_name(o.run.nms->rule)}, {"radius", o.run.nms->radius}, {"time_us", o.run.nms->time_us}};
+    else
+        j["nms"] = nullptr;
     j["detect_s"] = t.detect_s;
     j["wall_s"] = t.wall_s;
     if (t.damaged.empty())
@@ -114,6 +125,10 @@ void run_detect(DetectOptions& o) {
     ropts.topic = o.topic;
     o.run.param_prefix = "--";
     o.more.apply(ropts);
+    if (o.nms) {
+        o.nms_params.rule = parse_nms_rule(o.nms_rule);  // validated by CLI11
+        o.run.nms = o.nms_params;
+    }
 
     // The bar is drawn only on a terminal; the last update also tells how far a run that
     // stops at an input error got.
@@ -191,6 +206,7 @@ void add_detect_command(CLI::App& app) {
     cmd->add_flag("--with-score", o->run.with_score,
                   "Append the detector's score to each corner line ('t x y p score'); detectors with a score: " +
                       scored);
+    add_nms_options(*cmd, o->nms, o->nms_params, o->nms_rule);
     add_param_options(*cmd, o->run.detector.params);
     cmd->add_option("-j,--threads", o->run.threads,
                     "Detection threads (local detectors: " + local +
@@ -212,6 +228,7 @@ void add_detect_command(CLI::App& app) {
         "  evcorner detect recording.raw -o corners.npy      # Prophesee EVT 3 in, numpy out\n"
         "  evcorner detect events.txt --mask is_corner.txt --summary-json summary.json > corners.txt\n"
         "  evcorner detect events.txt -d harris --with-score | head\n"
+        "  evcorner detect events.txt --nms --nms-radius 2 --nms-time 2000 -o corners.txt\n"
         "  evcorner detect events.txt -d harris-global --harris-n 2000\n"
         "  evcorner detect events.txt -d harris -p harris-window=11 -p harris-nl=40\n"
         "  evcorner detect hd_recording.raw --threads 2 -o corners.npy\n"

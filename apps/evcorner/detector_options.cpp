@@ -126,4 +126,26 @@ std::vector<std::string> parse_detector_list(const std::string& list) {
 
 std::string all_detectors_list() { return detector_names(","); }
 
+void add_nms_options(CLI::App& cmd, bool& on, NmsParams& params, std::string& rule) {
+    const char* group = "Non-maximum suppression";
+    cmd.add_flag("--nms", on,
+                 "Asynchronous non-maximum suppression after the detector (docs/nms.md): a corner is dropped "
+                 "when an earlier corner of its polarity within --nms-radius px and --nms-time us has an equal or "
+                 "larger score (rule window) or an equal or larger decayed score (rule decay); decided at the "
+                 "corner's own time from the past only. Every detector has a score (docs/scores.md)")
+        ->group(group);
+    cmd.add_option("--nms-rule", rule, "window (a hard time window) or decay (scores decayed by exp(-dt/time))")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"window", "decay"}))
+        ->group(group);
+    cmd.add_option("--nms-radius", params.radius, "Neighbourhood half side in px (a (2r+1)^2 square)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, NmsParams::kMaxRadius))
+        ->group(group);
+    cmd.add_option("--nms-time", params.time_us, "Time window (rule window) or decay constant (rule decay), us")
+        ->capture_default_str()
+        ->check(CLI::Range(std::int64_t{1}, NmsParams::kMaxTimeUs))
+        ->group(group);
+}
+
 }  // namespace evcorner::cli

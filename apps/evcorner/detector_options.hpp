@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "evcorner/detector_config.hpp"
+#include "evcorner/nms.hpp"
 
 namespace evcorner::cli {
 
@@ -27,5 +28,9 @@ std::vector<std::string> parse_detector_list(const std::string& list);
 
 /// "efast,harris,harris-global": every registered detector.
 std::string all_detectors_list();
+
+/// --nms (sets `on`), --nms-rule window|decay, --nms-radius PX, --nms-time US (nms.hpp), in
+/// the "Non-maximum suppression" group.
+void add_nms_options(CLI::App& cmd, bool& on, NmsParams& params, std::string& rule);
 
 }  // namespace evcorner::cli

@@ -14,10 +14,12 @@
 
 #include "evcorner/arcstar_test.hpp"
 #include "evcorner/circle.hpp"
+#include "evcorner/corner_scores.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/event.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/sae.hpp"
+#include "evcorner/scored_detector.hpp"
 #include "evcorner/sensor.hpp"
 #include "evcorner/zeroed_array.hpp"
 
@@ -68,6 +70,21 @@ public:
         // the per-event filter then carries no tests of parameters.
         if (params_.filter && !params_.zero_init) return v.template run<Search, true>(events, is_corner);
         return v.template run<Search, false>(events, is_corner);
+    }
+
+    /// process_unchecked() that also writes the event's score (corner_scores.hpp,
+    /// docs/scores.md): computed for corner events only, NaN (kNoScore) for the others.
+    /// The binary paths never compute it.
+    bool process_scored_unchecked(const Event& e, double& score) noexcept {
+        return View::make(*this).process_scored<ScalarSearch>(e, score);
+    }
+    /// run_unchecked() with scores.
+    template <class Search>
+    std::size_t run_scored_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                                     std::span<double> score) noexcept {
+        const View v = View::make(*this);
+        if (params_.filter && !params_.zero_init) return v.template run_scored<Search, true>(events, is_corner, score);
+        return v.template run_scored<Search, false>(events, is_corner, score);
     }
 
     [[nodiscard]] const Params& params() const noexcept { return params_; }
@@ -136,6 +153,28 @@ private:
                 return false;
             return circles.pass<Search, kArc3Min, kArc3Max, kArc4Min, kArc4Max>(centre, minority_only);
         }
+
+        // process() and, for a corner, its score from the filtered SAE just updated.
+        template <class Search, bool Published = false>
+        bool process_scored(const Event& e, double& score) const noexcept {
+            const bool c = process<Search, Published>(e);
+            score = kNoScore;
+            if (c)
+                score = arcstar_score(plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x, width,
+                                      Sae::stored(e.t));
+            return c;
+        }
+        template <class Search, bool Published>
+        std::size_t run_scored(std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                               std::span<double> score) const noexcept {
+            std::size_t corners = 0;
+            for (std::size_t i = 0; i < events.size(); ++i) {
+                const bool c = process_scored<Search, Published>(events[i], score[i]);
+                is_corner[i] = static_cast<std::uint8_t>(c);
+                corners += c;
+            }
+            return corners;
+        }
     };
 
     Params params_;
@@ -143,6 +182,7 @@ private:
     ZeroedArray<ArcStarLatest> latest_;
 };
 static_assert(Detector<ArcStar>);
+static_assert(ScoredDetector<ArcStar>);
 
 /// detect() for Arc*: the same flags, with the fastest code this CPU runs (AVX-512, else
 /// AVX2, else portable), chosen once per process; EVCORNER_ARCSTAR_PATH=portable|avx2|avx512
@@ -151,6 +191,13 @@ static_assert(Detector<ArcStar>);
 std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
 /// detect() without the checks.
 std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+/// detect() with scores (scored_detector.hpp): the flags of detect(); score[i] is Arc*'s
+/// score for a corner, NaN otherwise. Portable or AVX2 search (the scored path is not the
+/// AVX-512 closed form, which finds no arc).
+std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                   std::span<double> score);
+std::size_t detect_unchecked(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             std::span<double> score) noexcept;
 /// The code path detect() runs: "avx512", "avx2" or "portable".
 const char* arcstar_code_path() noexcept;
 

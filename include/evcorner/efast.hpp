@@ -18,10 +18,12 @@
 
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
+#include "evcorner/corner_scores.hpp"
 #include "evcorner/detector.hpp"
 #include "evcorner/event.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/sae.hpp"
+#include "evcorner/scored_detector.hpp"
 #include "evcorner/sensor.hpp"
 
 namespace evcorner {
@@ -86,6 +88,27 @@ public:
         return corners;
     }
 
+    /// process_unchecked() that also writes the event's score (corner_scores.hpp,
+    /// docs/scores.md): computed for corner events only, NaN (kNoScore) for the others.
+    /// The binary paths above never compute it.
+    bool process_scored_unchecked(const Event& e, double& score) noexcept {
+        return View::template make<ScalarSearch>(sae_).template process_scored<ScalarSearch>(e, score);
+    }
+
+    /// run_unchecked() with scores (score[i] as process_scored_unchecked() writes it).
+    template <class Search>
+    std::size_t run_scored_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                                     std::span<double> score) noexcept {
+        const View v = View::template make<Search>(sae_);
+        std::size_t corners = 0;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            const bool c = v.template process_scored<Search>(events[i], score[i]);
+            is_corner[i] = static_cast<std::uint8_t>(c);
+            corners += c;
+        }
+        return corners;
+    }
+
     [[nodiscard]] const Sae& sae() const noexcept { return sae_; }
     [[nodiscard]] SensorSize size() const noexcept { return sae_.size(); }
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
@@ -139,11 +162,23 @@ private:
                            centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; });
             }
         }
+
+        // process() and, for a corner, its score from the SAE just updated.
+        template <class Search>
+        bool process_scored(const Event& e, double& score) const noexcept {
+            const bool c = process<Search>(e);
+            score = kNoScore;
+            if (c)
+                score = efast_score(plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x, width,
+                                    Sae::stored(e.t));
+            return c;
+        }
     };
 
     Sae sae_;
 };
 static_assert(Detector<EFast>);
+static_assert(ScoredDetector<EFast>);
 
 /// detect() for eFAST: the same flags, with the fastest code this CPU runs (AVX-512,
 /// else AVX2, else portable), chosen once per process; the environment variable
@@ -154,6 +189,13 @@ std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uin
 /// detect() without the checks: every event accepted by det.limits(), is_corner at
 /// least as long as events.
 std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+
+/// detect() with scores (scored_detector.hpp) on the same code path as detect(): the
+/// flags are those of detect(); score[i] is eFAST's score for a corner, NaN otherwise.
+std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                   std::span<double> score);
+std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             std::span<double> score) noexcept;
 
 /// The code path detect(EFast&, ...) takes: "avx512", "avx2" or "portable".
 const char* efast_code_path() noexcept;

@@ -104,6 +104,11 @@ void check_detect_options(const DetectOptions& o) {
                                     std::string(info.not_local) + "); " + local + " split the sensor");
     }
     if (o.threads > 1 && o.with_score) throw std::invalid_argument("--threads: --with-score needs one thread");
+    if (o.nms) {
+        if (!info.has_score)
+            throw std::invalid_argument("--nms: detector '" + o.detector.name + "' has no score to suppress by");
+        check_nms_params(*o.nms);
+    }
 }
 
 // ------------------------------------------------------------------ the run
@@ -248,25 +253,41 @@ DetectSummary run_detect(io::EventReader& reader, const DetectOptions& o, std::s
     with_detector_entry(o.detector.name, [&](const auto& entry) {
         using D = typename std::remove_cvref_t<decltype(entry)>::Detector;
         const auto params = entry.params_of(o.detector.params, o.param_prefix);
-        // The detector is built (and its errors raised) before anything is read.
-        std::unique_ptr<D> single;
-        std::unique_ptr<ParallelDetector<D>> par;
-        if (o.threads > 1)
-            par = std::make_unique<ParallelDetector<D>>(
-                s.sensor, o.threads, Locality(entry.radius(params), entry.split == Split::by_polarity),
-                [&entry, params](SensorSize z, int planes) { return entry.make(z, params, planes); });
-        else
-            single = std::make_unique<D>(entry.make(s.sensor, params));
-        try {
-            if (par)
-                run.parallel(*par);
+        // The detector is built (and its errors raised) before anything is read. With NMS,
+        // the detector is Suppressed<D> (nms.hpp), local with the radius grown by NMS's.
+        auto go = [&](auto tag, int radius, auto make) {
+            using R = typename decltype(tag)::type;
+            std::unique_ptr<R> single;
+            std::unique_ptr<ParallelDetector<R>> par;
+            if (o.threads > 1)
+                par = std::make_unique<ParallelDetector<R>>(
+                    s.sensor, o.threads, Locality(radius, entry.split == Split::by_polarity), make);
             else
-                run.single(*single);
-        } catch (const InputError& e) {
-            close_sinks();  // the outputs of the events before the error are complete
-            if (!o.allow_damaged) throw;
-            s.damaged = e.what();
+                single = std::make_unique<R>(make(s.sensor, 2));
+            try {
+                if (par)
+                    run.parallel(*par);
+                else
+                    run.single(*single);
+            } catch (const InputError& e) {
+                close_sinks();  // the outputs of the events before the error are complete
+                if (!o.allow_damaged) throw;
+                s.damaged = e.what();
+            }
+        };
+        const int radius = o.threads > 1 ? entry.radius(params) : 0;
+        if constexpr (ScoredDetector<D>) {
+            if (o.nms) {
+                const NmsParams nms = *o.nms;
+                go(std::type_identity<Suppressed<D>>{}, radius + nms.radius,
+                   [&entry, params, nms](SensorSize z, int planes) {
+                       return Suppressed<D>(entry.make(z, params, planes), nms, planes);
+                   });
+                return;
+            }
         }
+        go(std::type_identity<D>{}, radius,
+           [&entry, params](SensorSize z, int planes) { return entry.make(z, params, planes); });
     });
     if (s.damaged.empty()) close_sinks();
     s.skipped = reader.skipped();

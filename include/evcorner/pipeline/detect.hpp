@@ -30,6 +30,7 @@
 #include "evcorner/io/event_writer.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/text_writer.hpp"
+#include "evcorner/nms.hpp"
 #include "evcorner/sensor.hpp"
 
 namespace evcorner::pipeline {
@@ -98,6 +99,9 @@ struct DetectOptions {
     int threads = 1;             ///< > 1: local detectors only (the registry says which)
     bool with_score = false;     ///< pass scores to the sinks (detectors with a score; one thread)
     bool allow_damaged = false;  ///< an input error ends the input (summary.damaged) instead of failing
+    /// Asynchronous NMS after the detector (nms.hpp): the corners are the kept ones (with
+    /// threads > 1 too: the part halo grows by its radius; output identical to one thread).
+    std::optional<NmsParams> nms;
     std::size_t batch = std::size_t{1} << 16;  ///< events per read, 1..65536
     /// How error messages spell parameter keys ("--" on the command line).
     std::string param_prefix;
@@ -131,7 +135,7 @@ struct DetectSummary {
 
 /// Throws std::invalid_argument (a usage error) for an unknown detector, a parameter it
 /// does not take or out of range, with_score on a detector without a score or with
-/// threads > 1, threads outside 1..256 or on a detector that is not local (the message
+/// threads > 1, nms on a detector without a score or with parameters out of range, threads outside 1..256 or on a detector that is not local (the message
 /// says why, from the registry), a batch outside 1..65536.
 void check_detect_options(const DetectOptions& options);
 

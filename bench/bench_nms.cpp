@@ -1,0 +1,127 @@
+// The cost of eFAST's score and of asynchronous NMS (docs/nms.md) on the real 240x180
+// recordings: per pass and file, four loops with fresh state, in rotating order
+// (interleaved, so that load changes hit all alike):
+//   binary  detect(EFast&, events, flags)                 the published detector
+//   scored  detect(EFast&, events, flags, scores)         the score for each corner
+//   nms-w   detect(Suppressed<EFast>&, ...)  rule window  scored + NMS (defaults)
+//   nms-d   detect(Suppressed<EFast>&, ...)  rule decay
+// Checks that the scored flags equal the binary ones on every pass. Prints per file the
+// median ns/event of each and, over the files, the median of the per-file ratios.
+// Usage: bench_nms [PASSES=15]
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "evcorner/efast.hpp"
+#include "evcorner/nms.hpp"
+#include "real_files.hpp"
+
+namespace fs = std::filesystem;
+using namespace evcorner;
+
+namespace {
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+using Clock = std::chrono::steady_clock;
+}  // namespace
+
+// One loop once over one file, for callgrind: bench_nms once load|binary|scored|nms-w|nms-d FILE
+// (instructions per event = (I(mode) - I(load)) / events).
+int once(const std::string& mode, const std::string& file) {
+    const std::vector<Event> ev = bench::load_events(file);
+    std::vector<std::uint8_t> f(ev.size());
+    std::vector<double> sc(ev.size());
+    std::size_t c = 0;
+    NmsParams d;
+    d.rule = NmsRule::decay;
+    if (mode == "load") {  // the baseline: loading alone
+    } else if (mode == "binary") {
+        EFast det(kDavis240);
+        c = detect(det, ev, f);
+    } else if (mode == "scored") {
+        EFast det(kDavis240);
+        c = detect(det, ev, f, sc);
+    } else if (mode == "nms-w" || mode == "nms-d") {
+        Suppressed<EFast> det(EFast(kDavis240), mode == "nms-w" ? NmsParams{} : d);
+        c = detect(det, ev, f, sc);
+    } else {
+        std::fprintf(stderr, "bench_nms once: unknown mode %s\n", mode.c_str());
+        return 2;
+    }
+    std::printf("%s: %zu events, %zu corners\n", mode.c_str(), ev.size(), c);
+    return 0;
+}
+
+int main(int argc, char** argv) {
+    if (argc == 4 && std::string(argv[1]) == "once") return once(argv[2], argv[3]);
+    const int passes = argc > 1 ? std::max(1, std::atoi(argv[1])) : 15;
+    const auto real = bench::real_240x180_files(fs::path(EVCORNER_SHARED_DIR) / "data");
+    if (real.empty()) {
+        std::fprintf(stderr, "bench_nms: ../shared/data not found\n");
+        return 1;
+    }
+    constexpr int kLoops = 4;
+    const char* names[kLoops] = {"binary", "scored", "nms-w", "nms-d"};
+    std::vector<double> ratio_scored, ratio_nms_w, ratio_nms_d, ratio_nms_w_scored;
+    std::printf("%-20s %9s %9s %9s %9s %8s %8s %8s\n", "file", "binary", "scored", "nms-w", "nms-d", "corners",
+                "kept-w", "kept-d");
+    bool same = true;
+    for (const auto& r : real) {
+        const std::vector<Event> ev = bench::load_events(r.events);
+        const SensorSize size = kDavis240;
+        std::vector<std::uint8_t> f0(ev.size()), f1(ev.size());
+        std::vector<double> sc(ev.size());
+        std::vector<double> ns[kLoops];
+        std::size_t counts[kLoops] = {};
+        NmsParams w, d;
+        d.rule = NmsRule::decay;
+        for (int pass = 0; pass < passes; ++pass) {
+            for (int j = 0; j < kLoops; ++j) {
+                const int loop = (j + pass) % kLoops;
+                const auto t0 = Clock::now();
+                std::size_t c = 0;
+                if (loop == 0) {
+                    EFast det(size);
+                    c = detect(det, ev, f0);
+                } else if (loop == 1) {
+                    EFast det(size);
+                    c = detect(det, ev, f1, sc);
+                } else {
+                    Suppressed<EFast> det(EFast(size), loop == 2 ? w : d);
+                    c = detect(det, ev, f1, sc);
+                }
+                ns[loop].push_back(std::chrono::duration<double, std::nano>(Clock::now() - t0).count() /
+                                   static_cast<double>(ev.size()));
+                counts[loop] = c;
+                if (loop == 1 && f1 != f0 && pass > 0) same = false;
+            }
+        }
+        {  // the decisions once more, side by side
+            EFast a(size), b(size);
+            detect(a, ev, f0);
+            detect(b, ev, f1, sc);
+            same = same && f0 == f1;
+        }
+        const double m[kLoops] = {median(ns[0]), median(ns[1]), median(ns[2]), median(ns[3])};
+        std::printf("%-20s %9.2f %9.2f %9.2f %9.2f %8zu %8zu %8zu\n", r.name.c_str(), m[0], m[1], m[2], m[3], counts[0],
+                    counts[2], counts[3]);
+        ratio_scored.push_back(m[1] / m[0]);
+        ratio_nms_w.push_back(m[2] / m[0]);
+        ratio_nms_d.push_back(m[3] / m[0]);
+        ratio_nms_w_scored.push_back(m[2] / m[1]);
+    }
+    (void)names;
+    std::printf("median over files: scored/binary %.3f, nms-window/binary %.3f, nms-decay/binary %.3f, "
+                "nms-window/scored %.3f (ns/event medians of %d interleaved passes; path %s)\n",
+                median(ratio_scored), median(ratio_nms_w), median(ratio_nms_d), median(ratio_nms_w_scored), passes,
+                efast_code_path());
+    std::printf("scored flags identical to binary on every file: %s\n", same ? "yes" : "NO");
+    return same ? 0 : 1;
+}

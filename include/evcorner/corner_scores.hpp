@@ -1,0 +1,140 @@
+#pragma once
+// Scores for the two binary detectors, eFAST and Arc* (docs/scores.md), computed from the
+// detector's own state at the event's time: its SAE (stored values, sae.hpp) on the two
+// circles around the event. Only for corner events, after the binary decision, so that
+// the binary paths never pay for them.
+//
+// Both scores share one form:  S = (16 - L3) + (20 - L4) - 15 + f,  f in [0, 1)
+//  - L3, L4: the angular extent (in circle pixels) of the corner on the radius-3 and
+//    radius-4 circle. The shorter the arc of newest pixels, the farther the pattern is
+//    from a straight edge (an edge splits a circle in halves: 8 of 16, 10 of 20): the
+//    integer part is ANMS's eFAST score (Zhou et al. 2023), 7 (L3 = 6, L4 = 8, the
+//    bluntest corner) to 14 (L3 = 3, L4 = 4, the sharpest).
+//  - f: how cleanly the arc stands out in time, the normalised timestamp margin
+//    (oldest of the arc - newest of the rest) / (now - newest of the rest + 1), the
+//    smaller of the two circles', clamped to [0, 1). It only orders corners of equal
+//    arc lengths (a tie-breaker without units: no time constant).
+// eFAST: L = the shortest arc length that fires on the circle (the firing arc of length L
+// is the L newest pixels, all strictly newer than the rest). Arc*: L = min(size, N -
+// size) for the final arc size of its growth (a majority arc's corner is its complement).
+
+#include <algorithm>
+#include <cstdint>
+
+#include "evcorner/circle.hpp"
+
+namespace evcorner {
+
+namespace detail {
+// (a - b) / (now - b + 1) in [0, 1): a the arc's oldest, b the rest's newest, stored values.
+inline double time_margin(std::int64_t a, std::int64_t b, std::int64_t now) noexcept {
+    if (a <= b) return 0.0;
+    const double num = static_cast<double>(a - b);
+    const double den = static_cast<double>(std::max(now, a) - b) + 1.0;
+    const double f = num / den;
+    // At most 1 - 2^-40, so that adding the integer part (7..14) stays below the next integer.
+    constexpr double kBelowOne = 1.0 - 0x1p-40;
+    return f < kBelowOne ? f : kBelowOne;
+}
+
+struct ArcExtent {
+    int length = 0;      ///< 0: no arc in range
+    double margin = 0;   ///< time_margin of that arc
+};
+
+// eFAST on one circle t[0..N): the shortest firing length in Lmin..Lmax and its margin.
+template <int N, int Lmin, int Lmax>
+inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+    int k = 0;
+    for (int i = 1; i < N; ++i)
+        if (t[i] > t[k]) k = i;
+    // The arc [k-a, k+b] grows towards the newer neighbour (ties: right); the rest is the
+    // cyclic arc from k+b+1 to k-a-1.
+    int a = 0, b = 0;
+    std::int64_t oldest = t[k];
+    for (int len = 2; len <= Lmax; ++len) {
+        const std::int64_t l = t[(k - a - 1 + N) % N];
+        const std::int64_t r = t[(k + b + 1) % N];
+        const bool go_left = l > r;
+        a += go_left;
+        b += !go_left;
+        oldest = std::min(oldest, go_left ? l : r);
+        if (len < Lmin) continue;
+        std::int64_t rest = INT64_MIN;
+        for (int j = b + 1; j < N - a; ++j) rest = std::max(rest, t[(k + j) % N]);
+        if (oldest > rest) return {len, time_margin(oldest, rest, now)};
+    }
+    return {};
+}
+
+// Arc* on one circle t[0..N): its growth (arcstar_test.hpp) written plainly, recording
+// the order in which pixels join, then min(size, N - size) and the margin of the final arc.
+template <int N, int Lmin>
+inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+    int k = 0;
+    for (int i = 1; i < N; ++i)
+        if (t[i] > t[k]) k = i;
+    int order[N];
+    order[0] = k;
+    int cw = (k + 1) % N, ccw = (k - 1 + N) % N;
+    std::int64_t min_cw = t[cw], min_ccw = t[ccw];
+    std::int64_t seg = t[k];
+    int size = Lmin;
+    for (int it = 1; it < N; ++it) {
+        const bool go_cw = t[cw] > t[ccw];
+        const std::int64_t v = go_cw ? t[cw] : t[ccw];
+        const std::int64_t side_min = go_cw ? min_cw : min_ccw;
+        if (it < Lmin) {
+            seg = std::min(seg, side_min);
+        } else if (v >= seg) {
+            size = it + 1;
+            seg = std::min(seg, side_min);
+        }
+        order[it] = go_cw ? cw : ccw;
+        if (go_cw) {
+            cw = (cw + 1) % N;
+            min_cw = std::min(min_cw, t[cw]);
+        } else {
+            ccw = (ccw - 1 + N) % N;
+            min_ccw = std::min(min_ccw, t[ccw]);
+        }
+    }
+    std::int64_t in_oldest = INT64_MAX, out_newest = INT64_MIN;
+    for (int i = 0; i < N; ++i) {
+        if (i < size) in_oldest = std::min(in_oldest, t[order[i]]);
+        else out_newest = std::max(out_newest, t[order[i]]);
+    }
+    // A majority arc: the corner is the complement (older inside than the arc around it).
+    const bool majority = 2 * size > N;
+    const double m = majority ? 0.0 : time_margin(in_oldest, out_newest, now);
+    return {majority ? N - size : size, size == N ? 0.0 : m};
+}
+
+template <int N, class Circle>
+inline void gather(const std::int64_t* centre, std::ptrdiff_t width, const Circle& circle, std::int64_t* t) noexcept {
+    for (int k = 0; k < N; ++k) t[k] = centre[circle[k].dy * width + circle[k].dx];
+}
+
+inline double combine(ArcExtent c3, ArcExtent c4) noexcept {
+    return static_cast<double>((16 - c3.length) + (20 - c4.length) - 15) + std::min(c3.margin, c4.margin);
+}
+}  // namespace detail
+
+/// eFAST's score of a corner event whose SAE cell is `centre` (stored form, row stride
+/// `width`), at stored time `now`. For a non-corner the value means nothing.
+inline double efast_score(const std::int64_t* centre, std::ptrdiff_t width, std::int64_t now) noexcept {
+    std::int64_t t3[16], t4[20];
+    detail::gather<16>(centre, width, kCircle3, t3);
+    detail::gather<20>(centre, width, kCircle4, t4);
+    return detail::combine(detail::efast_arc_extent<16, 3, 6>(t3, now), detail::efast_arc_extent<20, 4, 8>(t4, now));
+}
+
+/// Arc*'s score of a corner event whose filtered-SAE cell is `centre`, at stored time `now`.
+inline double arcstar_score(const std::int64_t* centre, std::ptrdiff_t width, std::int64_t now) noexcept {
+    std::int64_t t3[16], t4[20];
+    detail::gather<16>(centre, width, kCircle3, t3);
+    detail::gather<20>(centre, width, kCircle4, t4);
+    return detail::combine(detail::arcstar_arc_extent<16, 3>(t3, now), detail::arcstar_arc_extent<20, 4>(t4, now));
+}
+
+}  // namespace evcorner

@@ -1,0 +1,179 @@
+#pragma once
+// Asynchronous non-maximum suppression (docs/nms.md): one stage after any scored
+// detector (scored_detector.hpp). It decides at each corner event's own time, from the
+// past only (a downstream tracker cannot wait), deterministically:
+//
+//   keep(e, s) -- e a corner event of score s (NaN reads as -infinity). Looks at the
+//                 latest earlier corner event at each pixel of e's polarity within the
+//                 (2 radius + 1)^2 square centred on e (e's own pixel included), of
+//                 time tc and score sc, dt = e.t - tc:
+//     rule window: e is suppressed iff some such corner has dt <= time_us and sc >= s;
+//     rule decay : e is suppressed iff some such corner has decayed(sc, dt) >= s, where
+//                  decayed(s, dt) = s * exp(-dt / time_us) for s >= 0 and s / exp(..)
+//                  for s < 0 (it falls with dt from s, for either sign), dt < 0 read as 0,
+//                  weight 0 beyond 700 time constants (ANMS's decayed neighbour scores,
+//                  Zhou et al. 2023).
+//                 Tie rule: an EQUAL (decayed) score suppresses (>=): the first of equals
+//                 is kept, as it was already passed on (decay: an equal score at dt > 0
+//                 has decayed below, so a later equal corner is kept too).
+//                 Then e becomes the latest corner of its pixel, suppressed or not.
+//
+// Every corner the detector finds is recorded, not only the kept ones: so whether a corner
+// is kept depends only on the corners within `radius` of it, and the stage is local (a
+// --threads part needs a halo of the detector's radius plus `radius`: parallel_detect.hpp).
+// Polarities are separate (a corner is compared with corners of its own polarity).
+//
+// Suppressed<D> composes the stage with a scored detector D into a detector (the
+// Detector concept; scored too): the pipeline, --threads and the bindings run it as any
+// other. Its batch loop runs D's own scored batch loop, then the stage over the corners.
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "evcorner/detector.hpp"
+#include "evcorner/event.hpp"
+#include "evcorner/event_check.hpp"
+#include "evcorner/scored_detector.hpp"
+#include "evcorner/sensor.hpp"
+#include "evcorner/zeroed_array.hpp"
+
+namespace evcorner {
+
+enum class NmsRule { window, decay };
+
+struct NmsParams {
+    NmsRule rule = NmsRule::window;
+    int radius = 2;                 ///< half side of the square neighbourhood, px, 0..kMaxRadius
+    std::int64_t time_us = 2000;    ///< window: the time window; decay: the decay constant; 1..kMaxTimeUs
+
+    static constexpr int kMaxRadius = 15;
+    static constexpr std::int64_t kMaxTimeUs = std::int64_t{1} << 40;
+};
+
+/// "window" or "decay".
+const char* nms_rule_name(NmsRule r) noexcept;
+/// NmsRule from "window" or "decay"; std::invalid_argument otherwise.
+NmsRule parse_nms_rule(std::string_view name);
+/// Throws std::invalid_argument naming the parameter when one is out of range.
+void check_nms_params(const NmsParams& p);
+
+class AsyncNms {
+public:
+    /// The times keep() takes (those of the SAE, sae.hpp).
+    static constexpr std::int64_t kMinTime = -(std::int64_t{1} << 62) + 1;
+    static constexpr std::int64_t kMaxTime = std::numeric_limits<std::int64_t>::max() - (std::int64_t{1} << 62);
+
+    /// `planes` = 1: one plane for both polarities (a caller feeding one polarity only).
+    AsyncNms(SensorSize size, const NmsParams& params, int planes = 2);
+
+    [[nodiscard]] static std::uint64_t state_bytes(SensorSize size, int planes = 2) noexcept {
+        return static_cast<std::uint64_t>(planes == 1 ? 1 : 2) * static_cast<std::uint64_t>(size.pixels()) *
+               sizeof(Cell);
+    }
+
+    /// Decides corner event `e` (on the sensor, p 0/1) of score `score`, and records it.
+    bool keep(const Event& e, double score) noexcept;
+
+    /// Runs keep() over the corners of a batch: is_corner[i] becomes 0 where events[i]
+    /// is suppressed. Returns the corners kept.
+    std::size_t filter(std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                       std::span<const double> score) noexcept;
+
+    [[nodiscard]] const NmsParams& params() const noexcept { return params_; }
+    [[nodiscard]] std::size_t memory_bytes() const noexcept { return cells_.size() * sizeof(Cell); }
+
+private:
+    struct Cell {
+        std::int64_t t;  ///< time + 2^62 of the latest corner here; 0 = none (zero pages)
+        double score;
+    };
+    NmsParams params_;
+    SensorSize size_;
+    int planes_;
+    double inv_time_;
+    ZeroedArray<Cell> cells_;
+};
+
+/// A scored detector followed by AsyncNms: a detector whose corners are the kept ones.
+template <ScoredDetector D>
+class Suppressed {
+public:
+    using Params = typename D::Params;
+
+    Suppressed(D det, const NmsParams& nms, int planes = 2)
+        : det_(std::move(det)), nms_(det_.limits().size, nms, planes) {}
+
+    /// The detector's limits, times within the stage's range (Sae::kMinTime..kMaxTime).
+    [[nodiscard]] EventLimits limits() const noexcept {
+        EventLimits l = det_.limits();
+        l.t_min = l.t_min > AsyncNms::kMinTime ? l.t_min : AsyncNms::kMinTime;
+        l.t_max = l.t_max < AsyncNms::kMaxTime ? l.t_max : AsyncNms::kMaxTime;
+        return l;
+    }
+    bool process(const Event& e) {
+        check_event(e, limits());
+        return process_unchecked(e);
+    }
+    bool process_unchecked(const Event& e) noexcept {
+        double s;
+        return process_scored_unchecked(e, s);
+    }
+    /// The detector's score (for every event it scores), and kept or not.
+    bool process_scored_unchecked(const Event& e, double& score) noexcept {
+        const bool c = evcorner::process_scored_unchecked(det_, e, score);
+        return c && nms_.keep(e, score);
+    }
+
+    [[nodiscard]] D& detector() noexcept { return det_; }
+    [[nodiscard]] const D& detector() const noexcept { return det_; }
+    [[nodiscard]] AsyncNms& nms() noexcept { return nms_; }
+    [[nodiscard]] std::size_t memory_bytes() const noexcept {
+        if constexpr (requires { det_.memory_bytes(); })
+            return det_.memory_bytes() + nms_.memory_bytes();
+        else
+            return nms_.memory_bytes();
+    }
+    /// A score buffer for the batch loops (grown, never shrunk).
+    std::span<double> scratch(std::size_t n) {
+        if (scratch_.size() < n) scratch_.resize(n);
+        return {scratch_.data(), n};
+    }
+
+private:
+    D det_;
+    AsyncNms nms_;
+    std::vector<double> scratch_;
+};
+
+/// The batch loops of Suppressed<D>: D's own scored batch loop (eFAST's fastest path, ...),
+/// then the stage over its corners.
+template <ScoredDetector D>
+std::size_t detect_unchecked(Suppressed<D>& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             std::span<double> score) noexcept {
+    detect_unchecked(det.detector(), events, is_corner, score);
+    return det.nms().filter(events, is_corner, score);
+}
+template <ScoredDetector D>
+std::size_t detect_unchecked(Suppressed<D>& det, std::span<const Event> events,
+                             std::span<std::uint8_t> is_corner) noexcept {
+    // The scratch buffer: allocation outside the per-event loop (a batch at a time).
+    std::span<double> score;
+    try {
+        score = det.scratch(events.size());
+    } catch (...) {
+        std::size_t corners = 0;  // no memory for a buffer: event by event
+        for (std::size_t i = 0; i < events.size(); ++i) corners += (is_corner[i] = det.process_unchecked(events[i]));
+        return corners;
+    }
+    return detect_unchecked(det, events, is_corner, score);
+}
+// The checked detect() of detector.hpp and scored_detector.hpp find these loops.
+
+}  // namespace evcorner

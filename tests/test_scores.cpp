@@ -1,0 +1,228 @@
+// Scores of eFAST and Arc* (corner_scores.hpp, docs/scores.md): they never change a binary
+// decision (seeded random streams, every Arc* variant, the golden files where
+// ../shared/data exists); a score exactly where there is a corner; drawn timestamp grids
+// where the more corner-like pattern scores higher; and every registered detector runs
+// scored through the registry's entry and the pipeline.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "arcstar_test_streams.hpp"
+#include "evcorner/arcstar.hpp"
+#include "evcorner/efast.hpp"
+#include "evcorner/io/open.hpp"
+#include "evcorner/io/text_reader.hpp"
+#include "evcorner/pipeline/detect.hpp"
+#include "evcorner/registry.hpp"
+#include "evcorner/scored_detector.hpp"
+#include "test_util.hpp"
+
+namespace evcorner {
+namespace {
+
+// Binary flags of a fresh detector and the scored run of another: identical flags, a
+// score (in [7, 15)) exactly for the corners; the per-event scored verb agrees too.
+template <class D, class Make>
+void expect_scores_keep_decisions(const std::vector<Event>& ev, Make make, const std::string& what) {
+    D bin = make(), sc = make(), one = make();
+    std::vector<std::uint8_t> f0(ev.size()), f1(ev.size());
+    std::vector<double> s(ev.size());
+    const std::size_t c0 = detect(bin, std::span<const Event>(ev), f0);
+    const std::size_t c1 = detect(sc, std::span<const Event>(ev), f1, s);
+    ASSERT_GT(c0, 0u) << what << ": no corners to compare";
+    EXPECT_EQ(c0, c1) << what;
+    for (std::size_t i = 0; i < ev.size(); ++i) {
+        ASSERT_EQ(f0[i], f1[i]) << what << " event " << i;
+        if (f1[i]) {
+            ASSERT_GE(s[i], 7.0) << what << " event " << i;
+            ASSERT_LT(s[i], 15.0) << what << " event " << i;
+        } else {
+            ASSERT_TRUE(std::isnan(s[i])) << what << " event " << i;
+        }
+        double s1 = 0;
+        ASSERT_EQ(process_scored_unchecked(one, ev[i], s1), f0[i] != 0) << what << " event " << i;
+        ASSERT_TRUE(f0[i] ? s1 == s[i] : std::isnan(s1)) << what << " event " << i;
+    }
+}
+
+TEST(Scores, EFastScoresNeverChangeDecisions) {
+    for (const SensorSize z : {SensorSize{64, 48}, SensorSize{240, 180}})
+        for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+            const auto ev = test::arcstar_stream(z, 60000, seed, 40, 60000);
+            expect_scores_keep_decisions<EFast>(ev, [z] { return EFast(z); }, "efast seed " + std::to_string(seed));
+        }
+}
+
+TEST(Scores, ArcStarScoresNeverChangeDecisions) {
+    for (int variant = 0; variant < 4; ++variant)
+        for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+            ArcStarParams p;
+            p.filter = variant != 1;
+            p.minority_only = variant == 2;
+            p.zero_init = variant == 3;
+            const SensorSize z{64, 48};
+            const auto ev = test::arcstar_stream(z, 60000, seed, 40, 60000);
+            expect_scores_keep_decisions<ArcStar>(ev, [z, p] { return ArcStar(z, p); },
+                                                  "arcstar variant " + std::to_string(variant) + " seed " +
+                                                      std::to_string(seed));
+        }
+}
+
+TEST(Scores, GoldenFilesUnchangedByScoredPaths) {
+    EVCORNER_REQUIRE_SHARED_DATA();
+    for (const auto& f : test::ecd_text_files()) {
+        SCOPED_TRACE(f.golden_prefix);
+        const auto ev = io::read_text_file(f.events.string());
+        for (const char* name : {"efast", "arcstar"}) {
+            const auto path = test::shared_data() / "golden" / (f.golden_prefix + "." + name + ".idx");
+            if (!std::filesystem::exists(path)) continue;  // (slider_depth has no Arc* golden)
+            const auto golden = test::read_index_file(path);
+            AnyDetector d = make_detector(name, kDavis240);
+            std::vector<std::uint8_t> flags(ev.size());
+            std::vector<double> s(ev.size());
+            std::visit([&](auto& det) {
+                if constexpr (ScoredDetector<std::decay_t<decltype(det)>>) detect(det, std::span<const Event>(ev), flags, s);
+            }, d);
+            std::vector<std::uint64_t> got;
+            for (std::size_t i = 0; i < flags.size(); ++i)
+                if (flags[i]) got.push_back(i);
+            EXPECT_EQ(got, golden) << name;
+        }
+    }
+}
+
+// A 9x9 drawn grid of SAE times around the centre (row y = -4..4, column x = -4..4): '.'
+// never fired, a digit its time in ms. Fed pixel by pixel in time order, then the centre
+// event at 10 ms; returns its score (NaN if not a corner).
+template <class D>
+double score_of_grid(const std::vector<std::string>& rows) {
+    D det(SensorSize{9, 9});
+    std::vector<Event> ev;
+    for (int y = 0; y < 9; ++y)
+        for (int x = 0; x < 9; ++x)
+            if (rows[static_cast<std::size_t>(y)][static_cast<std::size_t>(x)] != '.' && !(x == 4 && y == 4))
+                ev.push_back({1000 * (rows[static_cast<std::size_t>(y)][static_cast<std::size_t>(x)] - '0'),
+                              static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1});
+    std::stable_sort(ev.begin(), ev.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
+    ev.push_back({10000, 4, 4, 1});
+    double s = 0;
+    bool c = false;
+    for (const Event& e : ev) c = process_scored_unchecked(det, e, s);
+    return c ? s : kNoScore;
+}
+
+// A corner whose newest pixels fill a sector right of and below the centre: arcs of 3 and
+// 4 pixels (the sharpest eFAST accepts), a quadrant (5 and 6) and 135 degrees (6 and 8);
+// everything else fired long ago.
+const std::vector<std::string> kSharp = {
+    "111111111",
+    "111111111",
+    "111111111",
+    "111111111",
+    "111119999",
+    "111119999",
+    "111111991",
+    "111111911",
+    "111111111",
+};
+const std::vector<std::string> kRight = {
+    "111111111",
+    "111111111",
+    "111111111",
+    "111111111",
+    "111119999",
+    "111199999",
+    "111199999",
+    "111199999",
+    "111199999",
+};
+const std::vector<std::string> kBlunt = {
+    "111111111",
+    "111111111",
+    "111111111",
+    "111111111",
+    "111119999",
+    "111199999",
+    "111999999",
+    "119999999",
+    "199999999",
+};
+// kRight with the rest just 1 ms older than the corner: the same arcs, a smaller margin.
+const std::vector<std::string> kRightRecentRest = {
+    "888888888",
+    "888888888",
+    "888888888",
+    "888888888",
+    "888889999",
+    "888899999",
+    "888899999",
+    "888899999",
+    "888899999",
+};
+// A straight edge: half of each circle new (not a corner for either detector).
+const std::vector<std::string> kEdge = {
+    "111111111",
+    "111111111",
+    "111111111",
+    "111111111",
+    "999999999",
+    "999999999",
+    "999999999",
+    "999999999",
+    "999999999",
+};
+
+template <class D>
+void expect_sharper_scores_higher(const char* name) {
+    const double sharp = score_of_grid<D>(kSharp), right = score_of_grid<D>(kRight), blunt = score_of_grid<D>(kBlunt);
+    SCOPED_TRACE(name);
+    ASSERT_FALSE(std::isnan(sharp));
+    ASSERT_FALSE(std::isnan(right));
+    ASSERT_FALSE(std::isnan(blunt));
+    EXPECT_GT(sharp, right);
+    EXPECT_GT(right, blunt);
+    const double recent = score_of_grid<D>(kRightRecentRest);
+    ASSERT_FALSE(std::isnan(recent));
+    EXPECT_EQ(std::floor(recent), std::floor(right)) << "same arcs, same integer part";
+    EXPECT_GT(right, recent) << "a larger timestamp margin ranks higher";
+    EXPECT_TRUE(std::isnan(score_of_grid<D>(kEdge))) << "an edge is no corner and has no score";
+}
+
+TEST(Scores, EFastDrawnGridsRankCornerLikeness) { expect_sharper_scores_higher<EFast>("efast"); }
+TEST(Scores, ArcStarDrawnGridsRankCornerLikeness) { expect_sharper_scores_higher<ArcStar>("arcstar"); }
+
+TEST(Scores, EveryRegisteredDetectorHasAScore) {
+    for (const DetectorInfo& d : detector_infos()) EXPECT_TRUE(d.has_score) << d.name;
+}
+
+TEST(Scores, PipelineWithScoreForEveryDetector) {
+    // The bundled sample, --with-score through the library's pipeline: one score per
+    // corner, the same corners as without.
+    const std::string sample = (test::bundled_data() / "ecd/shapes_translation/events.txt").string();
+    for (const DetectorInfo& d : detector_infos()) {
+        SCOPED_TRACE(std::string(d.name));
+        pipeline::DetectOptions o;
+        o.detector.name = std::string(d.name);
+        std::vector<std::vector<Event>> corners;
+        for (bool with : {false, true}) {
+            o.with_score = with;
+            const auto reader = io::open_event_reader(sample);
+            pipeline::CollectSink sink;
+            pipeline::DetectSink* sinks[] = {&sink};
+            pipeline::run_detect(*reader, o, sinks);
+            if (with) {
+                ASSERT_EQ(sink.scores.size(), sink.corners.size());
+                for (double s : sink.scores) ASSERT_FALSE(std::isnan(s));
+            }
+            corners.push_back(sink.corners);
+        }
+        EXPECT_EQ(corners[0], corners[1]);
+    }
+}
+
+}  // namespace
+}  // namespace evcorner
