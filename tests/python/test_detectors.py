@@ -120,8 +120,10 @@ def test_bad_events_and_parameters(events):
         evcorner.Harris(240, 180, harris_window="seven")
     with pytest.raises(ValueError, match="unknown detector"):
         evcorner.detect(events, "nope")
-    with pytest.raises(TypeError, match="has no score"):
-        next(cls_of(d["name"]) for d in INFOS if not d["has_score"])(240, 180).process_scored(events)
+    unscored = [d for d in INFOS if not d["has_score"]]
+    if unscored:  # today every registered detector has a score; the refusal stays for one without
+        with pytest.raises(TypeError, match="has no score"):
+            cls_of(unscored[0]["name"])(240, 180).process_scored(events)
 
 
 def test_gil_is_released_during_detection(events):
