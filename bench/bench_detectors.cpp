@@ -17,99 +17,30 @@
 
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
-#include <cstdint>
-#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "evcorner/detector.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/registry.hpp"
-#include "real_files.hpp"
+#include "detector_runs.hpp"
 
-namespace fs = std::filesystem;
 using namespace evcorner;
-
-namespace {
-
-struct Input {
-    std::string name;
-    std::vector<Event> events;
-};
-
-std::vector<Input> load_inputs() {
-    std::vector<Input> inputs;
-    for (const auto& f : bench::real_240x180_files(fs::path(EVCORNER_SHARED_DIR) / "data"))
-        inputs.push_back({f.name, bench::load_events(f.events)});
-    if (inputs.empty())
-        inputs.push_back({"bundled_shapes_translation",
-                          bench::load_events(fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt")});
-    return inputs;
-}
-
-void per_event(benchmark::State& state, std::size_t events_per_iteration, std::size_t corners) {
-    const double n = static_cast<double>(events_per_iteration);
-    state.counters["time_per_event"] = benchmark::Counter(
-        n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-    state.counters["corners"] = static_cast<double>(corners);
-    state.SetItemsProcessed(static_cast<std::int64_t>(static_cast<double>(state.iterations()) * n));
-}
-
-template <bool Checked, class Make>
-void replay(benchmark::State& state, const Input* in, Make make) {
-    std::vector<std::uint8_t> flags(in->events.size());
-    std::size_t corners = 0;
-    for (auto _ : state) {
-        state.PauseTiming();
-        auto det = make();
-        state.ResumeTiming();
-        if constexpr (Checked)
-            corners = detect(det, in->events, flags);
-        else
-            corners = detect_unchecked(det, in->events, flags);
-        benchmark::DoNotOptimize(corners);
-    }
-    per_event(state, in->events.size(), corners);
-}
-
-template <class Make>
-void cold(benchmark::State& state, const std::vector<Input>* inputs, Make make) {
-    std::size_t longest = 0, total = 0;
-    for (const Input& in : *inputs) {
-        longest = std::max(longest, in.events.size());
-        total += in.events.size();
-    }
-    std::vector<std::uint8_t> flags(longest);
-    std::size_t corners = 0;
-    for (auto _ : state) {
-        corners = 0;
-        for (const Input& in : *inputs) {
-            state.PauseTiming();
-            auto det = make();
-            state.ResumeTiming();
-            corners += detect(det, in.events, std::span<std::uint8_t>(flags.data(), in.events.size()));
-        }
-        benchmark::DoNotOptimize(corners);
-    }
-    per_event(state, total, corners);
-}
-
-}  // namespace
+using evcorner::bench::Input;
 
 int main(int argc, char** argv) {
-    static const std::vector<Input> inputs = load_inputs();
+    static const std::vector<Input> inputs = bench::load_real_inputs();
     for_each_detector_entry([](const auto& entry) {
         const std::string name(entry.name);
         const auto make = [&entry] { return entry.make(kDavis240, {}); };
-        benchmark::RegisterBenchmark(("cold/" + name).c_str(), [make](benchmark::State& s) { cold(s, &inputs, make); })
+        benchmark::RegisterBenchmark(("cold/" + name).c_str(), [make](benchmark::State& s) { bench::cold<true>(s, &inputs, make); })
             ->Unit(benchmark::kMillisecond);
         for (const Input& in : inputs) {
             benchmark::RegisterBenchmark(("replay/" + name + "/" + in.name).c_str(),
-                                         [&in, make](benchmark::State& s) { replay<true>(s, &in, make); })
+                                         [&in, make](benchmark::State& s) { bench::replay<true>(s, &in, make); })
                 ->Unit(benchmark::kMillisecond);
             benchmark::RegisterBenchmark(("unchecked/" + name + "/" + in.name).c_str(),
-                                         [&in, make](benchmark::State& s) { replay<false>(s, &in, make); })
+                                         [&in, make](benchmark::State& s) { bench::replay<false>(s, &in, make); })
                 ->Unit(benchmark::kMillisecond);
         }
     });
@@ -117,7 +48,7 @@ int main(int argc, char** argv) {
         benchmark::RegisterBenchmark(("check_events/" + in.name).c_str(), [&in](benchmark::State& s) {
             const EventLimits limits = EFast(kDavis240).limits();
             for (auto _ : s) benchmark::DoNotOptimize(first_invalid_event(in.events, limits));
-            per_event(s, in.events.size(), 0);
+            bench::per_event(s, in.events.size(), 0);
         })->Unit(benchmark::kMillisecond);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
