@@ -115,24 +115,29 @@ double FaHarris::refine(int p, int x, int y) const noexcept {
         ++boundary;
     }
     std::uint16_t rows[HarrisScorer::kMaxWindow];
-    // The boundary bucket's cells with their (time, arrival) keys, gathered in the same pass.
+    // The boundary bucket's cells, by position (row << 4 | column), gathered in the same
+    // pass; their (time, arrival) keys are read afterwards for those few cells only.
+    std::uint8_t where[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
+    int m = 0;
+    for (int row = 0, i = 0; row < w; ++row) {
+        unsigned lit = 0;
+        for (int c = 0; c < w; ++c, ++i) {
+            lit |= static_cast<unsigned>(bucket[i] < boundary) << c;
+            where[m] = static_cast<std::uint8_t>(row << 4 | c);
+            m += bucket[i] == boundary;
+        }
+        rows[row] = static_cast<std::uint16_t>(lit);
+    }
     struct Key {
         std::int64_t t;
         std::uint64_t q;
         int row, col;
     };
     Key keys[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
-    int m = 0;
-    for (int row = 0, i = 0; row < w; ++row) {
-        unsigned lit = 0;
-        const std::int64_t* const tr = times + static_cast<std::size_t>(row) * stride_;
-        const std::uint64_t* const qr = seqs + static_cast<std::size_t>(row) * stride_;
-        for (int c = 0; c < w; ++c, ++i) {
-            lit |= static_cast<unsigned>(bucket[i] < boundary) << c;
-            keys[m] = {tr[c], qr[c], row, c};
-            m += bucket[i] == boundary;
-        }
-        rows[row] = static_cast<std::uint16_t>(lit);
+    for (int j = 0; j < m; ++j) {
+        const int row = where[j] >> 4, col = where[j] & 15;
+        const std::size_t at = static_cast<std::size_t>(row) * stride_ + static_cast<std::size_t>(col);
+        keys[j] = {times[at], seqs[at], row, col};
     }
     // Light the `take` newest of the boundary bucket: newer = later time, or the same time
     // and a later arrival (arrival numbers are unique among fired cells; never-fired cells,

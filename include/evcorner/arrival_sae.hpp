@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "evcorner/event.hpp"
 #include "evcorner/sensor.hpp"
@@ -57,6 +58,17 @@ public:
         // `&`, not `&&`: no branch on the polarity (which a compiler emitted, and mispredicted).
         cells_[static_cast<std::size_t>((e.p != 0) & (planes_ == 2)) * plane_size_ + index(e.x, e.y)] = ++last_;
         return last_;
+    }
+    /// update_unchecked() for every event of `events`, in order (one loop with the
+    /// state in registers: a store per event). Every event must lie on the sensor.
+    void update_unchecked(std::span<const Event> events) noexcept {
+        std::uint64_t* const cells = cells_.data() + static_cast<std::size_t>(pad_) * stride_ + pad_;
+        const std::size_t stride = stride_;
+        const std::size_t other = planes_ == 2 ? plane_size_ : 0;
+        std::uint64_t last = last_;
+        for (const Event& e : events)
+            cells[static_cast<std::size_t>(e.p != 0) * other + static_cast<std::size_t>(e.y) * stride + e.x] = ++last;
+        last_ = last;
     }
     /// The sequence number of the latest event (0 before the first).
     [[nodiscard]] std::uint64_t last() const noexcept { return last_; }

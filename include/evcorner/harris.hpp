@@ -63,6 +63,8 @@ public:
     /// update_unchecked() records `e` (accepted by limits()) and computes nothing; it
     /// leaves last_score() as it was.
     void update_unchecked(const Event& e) noexcept { sae_.update_unchecked(e); }
+    /// update_unchecked() for every event of `events`, in order.
+    void update_unchecked(std::span<const Event> events) noexcept { sae_.update_unchecked(events); }
     /// The score of `e`'s window as process() would compute it: `e` must be the latest
     /// event given to update_unchecked(). kNoScore for a border event or too few pixels.
     /// Changes nothing (last_score() included).
