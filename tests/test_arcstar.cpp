@@ -5,43 +5,19 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "evcorner/arcstar.hpp"
 #include "evcorner/naive/arcstar_naive.hpp"
+#include "grid_test_util.hpp"
 
 namespace evcorner {
 namespace {
 
-struct Cell {
-    std::int64_t t;
-    int x, y;
-};
-
-// A drawn 9x9 window of one polarity's SAE around 'E' ('.' = never fired), placed with its
-// top-left pixel at (x0, y0); cells sorted by time.
-std::vector<Cell> parse_grid(const std::vector<std::string>& rows, int x0, int y0, int& ex, int& ey) {
-    std::vector<Cell> cells;
-    for (int r = 0; r < static_cast<int>(rows.size()); ++r) {
-        std::istringstream in(rows[r]);
-        std::string tok;
-        for (int c = 0; in >> tok; ++c) {
-            if (tok == ".") continue;
-            if (tok == "E") {
-                ex = x0 + c;
-                ey = y0 + r;
-                continue;
-            }
-            cells.push_back({std::stoll(tok), x0 + c, y0 + r});
-        }
-    }
-    std::stable_sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.t < b.t; });
-    return cells;
-}
+using test::Cell;
+using test::parse_grid;
 
 // Feeds the grid (first events of their pixels: all pass the filter) then 'E' at t = 1000;
 // returns the fast detector's answer after checking that the oracle gives the same.

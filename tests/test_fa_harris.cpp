@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -15,6 +14,7 @@
 #include "arcstar_test_streams.hpp"
 #include "evcorner/fa_harris.hpp"
 #include "evcorner/naive/fa_harris_naive.hpp"
+#include "grid_test_util.hpp"
 
 namespace evcorner {
 namespace {
@@ -92,29 +92,8 @@ INSTANTIATE_TEST_SUITE_P(Sizes, FaHarrisVsOracle,
 
 // ---- drawn grids
 
-struct Cell {
-    std::int64_t t;
-    int x, y;
-};
-
-std::vector<Cell> parse_grid(const std::vector<std::string>& rows, int x0, int y0, int& ex, int& ey) {
-    std::vector<Cell> cells;
-    for (int r = 0; r < static_cast<int>(rows.size()); ++r) {
-        std::istringstream in(rows[r]);
-        std::string tok;
-        for (int c = 0; in >> tok; ++c) {
-            if (tok == ".") continue;
-            if (tok == "E") {
-                ex = x0 + c;
-                ey = y0 + r;
-                continue;
-            }
-            cells.push_back({std::stoll(tok), x0 + c, y0 + r});
-        }
-    }
-    std::stable_sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.t < b.t; });
-    return cells;
-}
+using test::Cell;
+using test::parse_grid;
 
 struct Result {
     bool corner;
