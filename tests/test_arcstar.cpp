@@ -25,13 +25,7 @@ bool grid_is_corner(const std::vector<std::string>& rows, const ArcStarParams& p
     const SensorSize size{20, 20};
     ArcStar fast(size, params);
     naive::ArcStarNaive oracle(size, params);
-    int ex = -1, ey = -1;
-    for (const Cell& c : parse_grid(rows, 5, 5, ex, ey)) {
-        const Event e{c.t, static_cast<std::uint16_t>(c.x), static_cast<std::uint16_t>(c.y), 1};
-        EXPECT_EQ(fast.process(e), oracle.process(e));
-    }
-    EXPECT_GE(ex, 0) << "grid has no 'E'";
-    const Event e{1000, static_cast<std::uint16_t>(ex), static_cast<std::uint16_t>(ey), 1};
+    const Event e = test::feed_grid(rows, fast, oracle, 1);
     const bool c = fast.process(e);
     EXPECT_EQ(c, oracle.process(e));
     return c;

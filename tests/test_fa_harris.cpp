@@ -92,9 +92,6 @@ INSTANTIATE_TEST_SUITE_P(Sizes, FaHarrisVsOracle,
 
 // ---- drawn grids
 
-using test::Cell;
-using test::parse_grid;
-
 struct Result {
     bool corner;
     double score;
@@ -105,13 +102,7 @@ Result run_grid(const std::vector<std::string>& rows, const FaHarrisParams& para
     const SensorSize size{20, 20};
     FaHarris fast(size, params);
     naive::FaHarrisNaive oracle(size, params);
-    int ex = -1, ey = -1;
-    for (const Cell& c : parse_grid(rows, 5, 5, ex, ey)) {
-        const Event e{c.t, static_cast<std::uint16_t>(c.x), static_cast<std::uint16_t>(c.y), 0};
-        EXPECT_EQ(fast.process(e), oracle.process(e));
-    }
-    EXPECT_GE(ex, 0) << "grid has no 'E'";
-    const Event e{1000, static_cast<std::uint16_t>(ex), static_cast<std::uint16_t>(ey), 0};
+    const Event e = test::feed_grid(rows, fast, oracle, 0);
     const Result r{fast.process(e), fast.last_score()};
     EXPECT_EQ(r.corner, oracle.process(e));
     EXPECT_TRUE(same_score(r.score, oracle.last_score())) << r.score << " vs " << oracle.last_score();
