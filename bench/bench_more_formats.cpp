@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "evcorner/io/open.hpp"
+#include "read_throughput.hpp"
 
 namespace {
 
@@ -152,31 +152,12 @@ void make_files() {
     }
 }
 
-void read_path(benchmark::State& state, const std::string& path, const char* format) {
-    if (!fs::exists(path)) {
-        state.SkipWithError(("missing " + path).c_str());
-        return;
-    }
-    std::vector<evcorner::Event> buf(1 << 16);
-    std::uint64_t events = 0;
-    for (auto _ : state) {
-        evcorner::io::ReaderOptions o;
-        o.fallback_sensor = std::nullopt;
-        auto r = evcorner::io::open_event_reader(path, o, format);
-        while (const std::size_t n = r->read(buf)) {
-            events += n;
-            benchmark::DoNotOptimize(buf.data());
-        }
-    }
-    state.counters["events/s"] = benchmark::Counter(static_cast<double>(events), benchmark::Counter::kIsRate);
-}
-
 void synthetic(benchmark::State& state, const std::string& name, const char* format) {
     make_files();
-    read_path(state, (dir() / name).string(), format);
+    evcorner::bench::read_throughput(state, (dir() / name).string(), format);
 }
 void real(benchmark::State& state, const std::string& rel) {
-    read_path(state, std::string(EVCORNER_SHARED_DIR) + "/data/real/" + rel, "auto");
+    evcorner::bench::read_throughput(state, evcorner::bench::real_data_file(rel));
 }
 
 BENCHMARK_CAPTURE(synthetic, atis_bin, std::string("a.bin"), "atis-bin")->Unit(benchmark::kMillisecond);

@@ -3,32 +3,14 @@
 
 #include <benchmark/benchmark.h>
 
-#include <filesystem>
 #include <string>
-#include <vector>
 
-#include "evcorner/io/open.hpp"
+#include "read_throughput.hpp"
 
 namespace {
 
 void read_file(benchmark::State& state, const std::string& rel) {
-    const std::string path = std::string(EVCORNER_SHARED_DIR) + "/data/real/" + rel;
-    if (!std::filesystem::exists(path)) {
-        state.SkipWithError(("missing " + path).c_str());
-        return;
-    }
-    std::vector<evcorner::Event> buf(1 << 16);
-    std::uint64_t events = 0;
-    for (auto _ : state) {
-        evcorner::io::ReaderOptions o;
-        o.fallback_sensor = std::nullopt;
-        auto r = evcorner::io::open_event_reader(path, o);
-        while (const std::size_t n = r->read(buf)) {
-            events += n;
-            benchmark::DoNotOptimize(buf.data());
-        }
-    }
-    state.counters["events/s"] = benchmark::Counter(static_cast<double>(events), benchmark::Counter::kIsRate);
+    evcorner::bench::read_throughput(state, evcorner::bench::real_data_file(rel));
 }
 
 BENCHMARK_CAPTURE(read_file, ecd_text, std::string("ecd-stppp/shapes_rotation/events.txt"))->Unit(benchmark::kMillisecond);

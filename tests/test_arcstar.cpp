@@ -5,43 +5,19 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "evcorner/arcstar.hpp"
 #include "evcorner/naive/arcstar_naive.hpp"
+#include "grid_test_util.hpp"
 
 namespace evcorner {
 namespace {
 
-struct Cell {
-    std::int64_t t;
-    int x, y;
-};
-
-// A drawn 9x9 window of one polarity's SAE around 'E' ('.' = never fired), placed with its
-// top-left pixel at (x0, y0); cells sorted by time.
-std::vector<Cell> parse_grid(const std::vector<std::string>& rows, int x0, int y0, int& ex, int& ey) {
-    std::vector<Cell> cells;
-    for (int r = 0; r < static_cast<int>(rows.size()); ++r) {
-        std::istringstream in(rows[r]);
-        std::string tok;
-        for (int c = 0; in >> tok; ++c) {
-            if (tok == ".") continue;
-            if (tok == "E") {
-                ex = x0 + c;
-                ey = y0 + r;
-                continue;
-            }
-            cells.push_back({std::stoll(tok), x0 + c, y0 + r});
-        }
-    }
-    std::stable_sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.t < b.t; });
-    return cells;
-}
+using test::Cell;
+using test::parse_grid;
 
 // Feeds the grid (first events of their pixels: all pass the filter) then 'E' at t = 1000;
 // returns the fast detector's answer after checking that the oracle gives the same.
@@ -49,13 +25,7 @@ bool grid_is_corner(const std::vector<std::string>& rows, const ArcStarParams& p
     const SensorSize size{20, 20};
     ArcStar fast(size, params);
     naive::ArcStarNaive oracle(size, params);
-    int ex = -1, ey = -1;
-    for (const Cell& c : parse_grid(rows, 5, 5, ex, ey)) {
-        const Event e{c.t, static_cast<std::uint16_t>(c.x), static_cast<std::uint16_t>(c.y), 1};
-        EXPECT_EQ(fast.process(e), oracle.process(e));
-    }
-    EXPECT_GE(ex, 0) << "grid has no 'E'";
-    const Event e{1000, static_cast<std::uint16_t>(ex), static_cast<std::uint16_t>(ey), 1};
+    const Event e = test::feed_grid(rows, fast, oracle, 1);
     const bool c = fast.process(e);
     EXPECT_EQ(c, oracle.process(e));
     return c;

@@ -4,42 +4,18 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "evcorner/efast.hpp"
 #include "evcorner/naive/efast_naive.hpp"
+#include "grid_test_util.hpp"
 
 namespace evcorner {
 namespace {
 
-struct Cell {
-    std::int64_t t;
-    int x, y;
-};
-
-// Parses a drawn grid placed with its top-left pixel at (x0, y0). Returns the cells
-// with a timestamp and sets (ex, ey) to the 'E' cell.
-std::vector<Cell> parse_grid(const std::vector<std::string>& rows, int x0, int y0, int& ex, int& ey) {
-    std::vector<Cell> cells;
-    for (int r = 0; r < static_cast<int>(rows.size()); ++r) {
-        std::istringstream in(rows[r]);
-        std::string tok;
-        for (int c = 0; in >> tok; ++c) {
-            if (tok == ".") continue;
-            if (tok == "E") {
-                ex = x0 + c;
-                ey = y0 + r;
-                continue;
-            }
-            cells.push_back({std::stoll(tok), x0 + c, y0 + r});
-        }
-    }
-    std::stable_sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.t < b.t; });
-    return cells;
-}
+using test::Cell;
+using test::parse_grid;
 
 struct Outcome {
     bool fast;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "blob_stream.hpp"
 #include "evcorner/efast.hpp"
 #include "evcorner/efast_harris.hpp"
 #include "evcorner/harris.hpp"
@@ -27,36 +28,10 @@ namespace {
 // timestamps, a share of uniform clutter (borders included), mostly one polarity so that
 // windows fill up.
 std::vector<Event> random_stream(SensorSize s, std::size_t n, std::uint64_t seed, int polarity = -1) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    std::normal_distribution<double> spread(0.0, 2.5);
-    struct Blob {
-        double x, y, vx, vy;
-    };
-    std::vector<Blob> blobs(3);
-    for (auto& b : blobs) b = {unit(rng) * s.width, unit(rng) * s.height, unit(rng) - 0.5, unit(rng) - 0.5};
-    std::vector<Event> ev;
-    ev.reserve(n);
-    std::int64_t t = 1000;
-    for (std::size_t i = 0; i < n; ++i) {
-        t += static_cast<std::int64_t>(rng() % 3);  // 0: same timestamp as before
-        int x, y;
-        if (unit(rng) < 0.07) {
-            x = static_cast<int>(rng() % static_cast<unsigned>(s.width));
-            y = static_cast<int>(rng() % static_cast<unsigned>(s.height));
-        } else {
-            Blob& b = blobs[rng() % blobs.size()];
-            b.x += b.vx * 0.05;
-            b.y += b.vy * 0.05;
-            if (b.x < 0 || b.x >= s.width) b.vx = -b.vx;
-            if (b.y < 0 || b.y >= s.height) b.vy = -b.vy;
-            x = std::clamp(static_cast<int>(std::lround(b.x + spread(rng))), 0, s.width - 1);
-            y = std::clamp(static_cast<int>(std::lround(b.y + spread(rng))), 0, s.height - 1);
-        }
-        const int p = polarity >= 0 ? polarity : static_cast<int>(rng() % 4 == 0);
-        ev.push_back({t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), static_cast<std::uint8_t>(p)});
-    }
-    return ev;
+    return test::blob_stream(s, n, seed, {.blobs = 3, .spread = 2.5, .clutter = 0.07, .round = true}, test::tie_steps,
+                             [polarity](std::mt19937_64& rng) {
+                                 return polarity >= 0 ? polarity : static_cast<int>(rng() % 4 == 0);
+                             });
 }
 
 bool same_score(double fast, double naive) {

@@ -6,49 +6,17 @@
 #include <random>
 #include <vector>
 
+#include "blob_stream.hpp"
 #include "evcorner/efast.hpp"
 #include "evcorner/naive/efast_naive.hpp"
 
 namespace evcorner {
 namespace {
 
-// Events clustered around drifting blobs (so that circles see structure), with many
-// equal timestamps (ties) and a share of events on the border.
+// Events clustered around drifting blobs (filled squares, so that circles see edges and
+// corners), with many equal timestamps (ties) and 5 % uniform clutter, borders included.
 std::vector<Event> random_stream(SensorSize s, std::size_t n, std::uint32_t seed) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    std::normal_distribution<double> spread(0.0, 3.0);
-    struct Blob {
-        double x, y, vx, vy;
-    };
-    std::vector<Blob> blobs(4);
-    for (auto& b : blobs)
-        b = {unit(rng) * s.width, unit(rng) * s.height, unit(rng) - 0.5, unit(rng) - 0.5};
-    std::vector<Event> ev;
-    ev.reserve(n);
-    std::int64_t t = 1000;
-    for (std::size_t i = 0; i < n; ++i) {
-        t += static_cast<std::int64_t>(rng() % 3);  // 0: same timestamp as before
-        int x, y;
-        if (unit(rng) < 0.05) {  // uniform clutter, borders included
-            x = static_cast<int>(rng() % static_cast<unsigned>(s.width));
-            y = static_cast<int>(rng() % static_cast<unsigned>(s.height));
-        } else {
-            Blob& b = blobs[rng() % blobs.size()];
-            b.x += b.vx * 0.05;
-            b.y += b.vy * 0.05;
-            if (b.x < 0 || b.x >= s.width) b.vx = -b.vx;
-            if (b.y < 0 || b.y >= s.height) b.vy = -b.vy;
-            // A blob is a filled square: its edges and corners move with it.
-            x = static_cast<int>(b.x + spread(rng));
-            y = static_cast<int>(b.y + spread(rng));
-            x = std::clamp(x, 0, s.width - 1);
-            y = std::clamp(y, 0, s.height - 1);
-        }
-        ev.push_back({t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
-                      static_cast<std::uint8_t>(rng() & 1)});
-    }
-    return ev;
+    return test::blob_stream(s, n, seed, {});
 }
 
 class EFastVsOracle : public ::testing::TestWithParam<SensorSize> {};

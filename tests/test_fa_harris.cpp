@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -15,6 +14,7 @@
 #include "arcstar_test_streams.hpp"
 #include "evcorner/fa_harris.hpp"
 #include "evcorner/naive/fa_harris_naive.hpp"
+#include "grid_test_util.hpp"
 
 namespace evcorner {
 namespace {
@@ -92,30 +92,6 @@ INSTANTIATE_TEST_SUITE_P(Sizes, FaHarrisVsOracle,
 
 // ---- drawn grids
 
-struct Cell {
-    std::int64_t t;
-    int x, y;
-};
-
-std::vector<Cell> parse_grid(const std::vector<std::string>& rows, int x0, int y0, int& ex, int& ey) {
-    std::vector<Cell> cells;
-    for (int r = 0; r < static_cast<int>(rows.size()); ++r) {
-        std::istringstream in(rows[r]);
-        std::string tok;
-        for (int c = 0; in >> tok; ++c) {
-            if (tok == ".") continue;
-            if (tok == "E") {
-                ex = x0 + c;
-                ey = y0 + r;
-                continue;
-            }
-            cells.push_back({std::stoll(tok), x0 + c, y0 + r});
-        }
-    }
-    std::stable_sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.t < b.t; });
-    return cells;
-}
-
 struct Result {
     bool corner;
     double score;
@@ -126,13 +102,7 @@ Result run_grid(const std::vector<std::string>& rows, const FaHarrisParams& para
     const SensorSize size{20, 20};
     FaHarris fast(size, params);
     naive::FaHarrisNaive oracle(size, params);
-    int ex = -1, ey = -1;
-    for (const Cell& c : parse_grid(rows, 5, 5, ex, ey)) {
-        const Event e{c.t, static_cast<std::uint16_t>(c.x), static_cast<std::uint16_t>(c.y), 0};
-        EXPECT_EQ(fast.process(e), oracle.process(e));
-    }
-    EXPECT_GE(ex, 0) << "grid has no 'E'";
-    const Event e{1000, static_cast<std::uint16_t>(ex), static_cast<std::uint16_t>(ey), 0};
+    const Event e = test::feed_grid(rows, fast, oracle, 0);
     const Result r{fast.process(e), fast.last_score()};
     EXPECT_EQ(r.corner, oracle.process(e));
     EXPECT_TRUE(same_score(r.score, oracle.last_score())) << r.score << " vs " << oracle.last_score();

@@ -287,15 +287,7 @@ TEST(Bom, TextAndCsvAcceptAUtf8ByteOrderMark) {
 
 // ---------------------------------------------------------------- .npy
 
-std::string npy_file(const std::string& dict_body, const std::string& data) {
-    std::string dict = dict_body;
-    while ((10 + dict.size() + 1) % 64 != 0) dict += ' ';
-    dict += '\n';
-    std::string f("\x93NUMPY\x01\x00", 8);
-    f += static_cast<char>(dict.size() & 0xFF);
-    f += static_cast<char>(dict.size() >> 8);
-    return f + dict + data;
-}
+using test::npy_file;
 
 // Appends v as `size` bytes, little- or big-endian.
 template <class T>

@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "blob_stream.hpp"
 #include "evcorner/efast.hpp"
 #include "evcorner/harris.hpp"
 #include "evcorner/io/text_reader.hpp"
@@ -23,35 +24,8 @@ namespace {
 
 // Blobs drifting over the sensor (edges and corners), uniform clutter, ties in time.
 std::vector<Event> random_stream(SensorSize s, std::size_t n, std::uint32_t seed) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    std::normal_distribution<double> spread(0.0, 4.0);
-    struct Blob {
-        double x, y, vx, vy;
-    };
-    std::vector<Blob> blobs(12);
-    for (auto& b : blobs) b = {unit(rng) * s.width, unit(rng) * s.height, 4 * (unit(rng) - 0.5), 4 * (unit(rng) - 0.5)};
-    std::vector<Event> ev;
-    std::int64_t t = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        t += static_cast<std::int64_t>(rng() % 3);
-        int x, y;
-        if (unit(rng) < 0.1) {
-            x = static_cast<int>(rng() % static_cast<unsigned>(s.width));
-            y = static_cast<int>(rng() % static_cast<unsigned>(s.height));
-        } else {
-            Blob& b = blobs[rng() % blobs.size()];
-            b.x += b.vx * 0.01;
-            b.y += b.vy * 0.01;
-            if (b.x < 0 || b.x >= s.width) b.vx = -b.vx;
-            if (b.y < 0 || b.y >= s.height) b.vy = -b.vy;
-            x = std::clamp(static_cast<int>(b.x + spread(rng)), 0, s.width - 1);
-            y = std::clamp(static_cast<int>(b.y + spread(rng)), 0, s.height - 1);
-        }
-        ev.push_back({t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
-                      static_cast<std::uint8_t>(rng() & 1)});
-    }
-    return ev;
+    return test::blob_stream(s, n, seed,
+                             {.blobs = 12, .speed = 4, .spread = 4.0, .drift = 0.01, .clutter = 0.1, .start_t = 0});
 }
 
 template <class D, class Make>

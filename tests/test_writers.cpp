@@ -116,15 +116,7 @@ TEST(Npy, HeaderFollowsTheSpec) {
 
 TEST(Npy, PackedDtypeAndDamage) {
     TempDir tmp;
-    auto npy = [](const std::string& dict_body, const std::string& data) {
-        std::string dict = dict_body;
-        while ((10 + dict.size() + 1) % 64 != 0) dict += ' ';
-        dict += '\n';
-        std::string f("\x93NUMPY\x01\x00", 8);
-        f += static_cast<char>(dict.size() & 0xFF);
-        f += static_cast<char>(dict.size() >> 8);
-        return f + dict + data;
-    };
+    const auto npy = test::npy_file;
     auto rec13 = [](std::int64_t t, std::uint16_t x, std::uint16_t y, std::uint8_t p) {
         std::string r(13, '\0');
         std::memcpy(r.data(), &t, 8);

@@ -18,9 +18,8 @@
 
 #include <fmt/format.h>
 #include <map>
-#include <set>
 
-#include "bag_source.hpp"
+#include "record_bag.hpp"
 #include "evcorner/io/byte_order.hpp"
 
 namespace evcorner::io::detail {
@@ -30,10 +29,9 @@ namespace {
 constexpr std::size_t kRecordHeader = 9;
 constexpr std::size_t kMessageFields = 2 + 4 + 8 + 8;
 
-class McapBag final : public BagSource {
+class McapBag final : public RecordBag {
 public:
-    McapBag(std::unique_ptr<ByteSource> bytes, std::string name) : b_(std::move(bytes)), name_(std::move(name)) {
-        size_ = b_->size();
+    McapBag(std::unique_ptr<ByteSource> bytes, std::string name) : RecordBag(std::move(bytes), std::move(name), 8) {
         unsigned char magic[8] = {};
         const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_, 8));
         b_->read_at(0, n, magic);
@@ -47,27 +45,8 @@ public:
         build_topics();
     }
 
-    [[nodiscard]] const std::vector<BagTopic>& topics() const noexcept override { return topics_; }
-    void select(const std::string& topic) override {
-        selected_.clear();
-        for (const auto& [id, c] : channels_)
-            if (c.topic == topic) selected_.insert(id);
-        restart();
-    }
-    bool next(BagMessage& m) override {
-        while (step()) {
-            if (!msg_) continue;
-            msg_ = false;
-            m = std::move(current_);
-            m.index = index_++;
-            return true;
-        }
-        return false;
-    }
+    void select(const std::string& topic) override { select_channels(channels_, topic); }
     [[nodiscard]] std::string_view format() const noexcept override { return "mcap"; }
-    [[nodiscard]] const std::string& name() const noexcept override { return name_; }
-    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return pos_; }
-    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return size_; }
 
 private:
     struct Channel {
@@ -76,16 +55,9 @@ private:
         std::string encoding;
     };
 
-    [[noreturn]] void fail(std::uint64_t at, const std::string& reason) const {
-        throw InputError(name_, InputError::Unit::byte, at, reason);
-    }
-
-    void restart() {
-        pos_ = 8;
-        in_chunk_ = false;
+    void restart() override {
+        RecordBag::restart();
         ended_ = false;
-        index_ = 0;
-        msg_ = false;
     }
 
     void add_schema(std::span<const unsigned char> c) {
@@ -153,15 +125,7 @@ private:
         channels_.clear();
         schemas_.clear();
         counts_.clear();
-        counting_ = true;
-        restart();
-        try {
-            while (step()) {
-            }
-        } catch (const InputError&) {
-            scan_error_ = std::current_exception();
-        }
-        counting_ = false;
+        count_records();
         restart();
     }
 
@@ -180,7 +144,7 @@ private:
 
     // One record of a chunk, or of the data section; true while there are records.
     // Sets msg_ (and current_) when the record is a message of a selected channel.
-    bool step() {
+    bool step() override {
         if (in_chunk_) {
             if (chunk_pos_ < chunk_.size()) {
                 const std::size_t at = chunk_pos_;
@@ -235,12 +199,6 @@ private:
         }
     }
 
-    [[noreturn]] void chunk_fail(std::size_t at, const std::string& reason) const {
-        if (chunk_plain_) fail(chunk_data_at_ + at, reason);
-        throw InputError(name_, InputError::Unit::byte, chunk_at_,
-                         fmt::format("in the {} chunk, at its decompressed byte {}: {}", chunk_method_, at, reason));
-    }
-
     // A Schema, Channel or Message record at `at` (a file offset, or an offset in the chunk).
     void record(std::uint8_t op, std::span<const unsigned char> c, std::uint64_t at, bool in_chunk) {
         try {
@@ -255,18 +213,7 @@ private:
                 return;
             }
             if (!selected_.contains(channel)) return;
-            current_.data = c.subspan(kMessageFields);
-            if (!in_chunk)
-                current_.offset = at + kMessageFields;
-            else if (chunk_plain_)
-                current_.offset = chunk_data_at_ + at + kMessageFields;
-            else {
-                current_.offset.reset();
-                current_.chunk_at = chunk_at_;
-                current_.where = fmt::format("in the {} chunk at byte {}, its decompressed byte {}", chunk_method_,
-                                             chunk_at_, at + kMessageFields);
-            }
-            msg_ = true;
+            found(c.subspan(kMessageFields), at + kMessageFields, in_chunk);
         } catch (const Truncated& t) {
             const char* what = op == 0x03 ? "Schema" : op == 0x04 ? "Channel" : "Message";
             const std::string reason = fmt::format("the {} record ends inside its fields", what);
@@ -316,32 +263,10 @@ private:
         in_chunk_ = true;
     }
 
-    std::unique_ptr<ByteSource> b_;
-    std::string name_;
-    std::uint64_t size_ = 0;
     std::map<std::uint16_t, std::string> schemas_;
     std::map<std::uint16_t, Channel> channels_;
     std::map<std::uint16_t, std::uint64_t> counts_;
-    std::vector<BagTopic> topics_;
-    std::set<std::uint16_t> selected_;
-    bool counting_ = false;
-    std::exception_ptr scan_error_;  // damage the pass over the file met
-
-    std::uint64_t pos_ = 8;
     bool ended_ = false;
-    std::vector<unsigned char> rec_;
-    std::vector<unsigned char> raw_;
-    std::vector<unsigned char> chunk_;
-    std::size_t chunk_pos_ = 0;
-    bool in_chunk_ = false;
-    bool chunk_plain_ = false;
-    std::string chunk_method_;
-    std::uint64_t chunk_at_ = 0;
-    std::uint64_t chunk_data_at_ = 0;
-
-    BagMessage current_;
-    bool msg_ = false;
-    std::uint64_t index_ = 0;
 };
 
 }  // namespace

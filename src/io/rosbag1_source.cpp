@@ -14,9 +14,8 @@
 
 #include <fmt/format.h>
 #include <map>
-#include <set>
 
-#include "bag_source.hpp"
+#include "record_bag.hpp"
 #include "evcorner/io/byte_order.hpp"
 
 namespace evcorner::io::detail {
@@ -66,10 +65,10 @@ private:
     std::vector<std::pair<std::string_view, std::string_view>> items_;
 };
 
-class Ros1Bag final : public BagSource {
+class Ros1Bag final : public RecordBag {
 public:
-    Ros1Bag(std::unique_ptr<ByteSource> bytes, std::string name) : b_(std::move(bytes)), name_(std::move(name)) {
-        size_ = b_->size();
+    Ros1Bag(std::unique_ptr<ByteSource> bytes, std::string name)
+        : RecordBag(std::move(bytes), std::move(name), kMagicSize) {
         unsigned char magic[kMagicSize] = {};
         const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_, kMagicSize));
         b_->read_at(0, n, magic);
@@ -101,27 +100,8 @@ public:
         restart();
     }
 
-    [[nodiscard]] const std::vector<BagTopic>& topics() const noexcept override { return topics_; }
-    void select(const std::string& topic) override {
-        selected_.clear();
-        for (const auto& [id, c] : conns_)
-            if (c.topic == topic) selected_.insert(id);
-        restart();
-    }
-    bool next(BagMessage& m) override {
-        while (step()) {
-            if (!msg_) continue;
-            msg_ = false;
-            m = std::move(current_);
-            m.index = index_++;
-            return true;
-        }
-        return false;
-    }
+    void select(const std::string& topic) override { select_channels(conns_, topic); }
     [[nodiscard]] std::string_view format() const noexcept override { return "rosbag"; }
-    [[nodiscard]] const std::string& name() const noexcept override { return name_; }
-    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return pos_; }
-    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return size_; }
 
 private:
     struct Conn {
@@ -134,17 +114,6 @@ private:
         std::uint64_t data_at = 0;  // its data's offset
         std::uint32_t data_len = 0;
     };
-
-    [[noreturn]] void fail(std::uint64_t at, const std::string& reason) const {
-        throw InputError(name_, InputError::Unit::byte, at, reason);
-    }
-
-    void restart() {
-        pos_ = data_start_;
-        in_chunk_ = false;
-        msg_ = false;
-        index_ = 0;
-    }
 
     // The record at `pos` (its header parsed into fields_); pos moves past it.
     Top read_top(std::uint64_t& pos) {
@@ -214,25 +183,11 @@ private:
     void scan() {
         conns_.clear();
         counts_.clear();
-        counting_ = true;
-        restart();
-        try {
-            while (step()) {
-            }
-        } catch (const InputError&) {
-            scan_error_ = std::current_exception();
-        }
-        counting_ = false;
-    }
-
-    [[noreturn]] void chunk_fail(std::size_t at, const std::string& reason) const {
-        if (chunk_plain_) fail(chunk_data_at_ + at, reason);
-        throw InputError(name_, InputError::Unit::byte, chunk_at_,
-                         fmt::format("in the {} chunk, at its decompressed byte {}: {}", chunk_method_, at, reason));
+        count_records();
     }
 
     // One record; true while there are records. Sets msg_ for a selected message.
-    bool step() {
+    bool step() override {
         if (in_chunk_) {
             if (chunk_pos_ < chunk_.size()) {
                 const std::size_t at = chunk_pos_;
@@ -297,18 +252,7 @@ private:
             return;
         }
         if (!selected_.contains(*conn)) return;
-        current_.data = data;
-        if (!in_chunk)
-            current_.offset = data_at;
-        else if (chunk_plain_)
-            current_.offset = chunk_data_at_ + data_at;
-        else {
-            current_.offset.reset();
-            current_.chunk_at = chunk_at_;
-            current_.where = fmt::format("in the {} chunk at byte {}, its decompressed byte {}", chunk_method_,
-                                         chunk_at_, data_at);
-        }
-        msg_ = true;
+        found(data, data_at, in_chunk);
     }
 
     void load_chunk(const Top& r) {
@@ -339,34 +283,12 @@ private:
         in_chunk_ = true;
     }
 
-    std::unique_ptr<ByteSource> b_;
-    std::string name_;
-    std::uint64_t size_ = 0;
-    std::uint64_t data_start_ = 0;
     std::uint64_t end_ = 0;
     std::map<std::uint32_t, Conn> conns_;
     std::map<std::uint32_t, std::uint64_t> counts_;
-    std::vector<BagTopic> topics_;
-    std::set<std::uint32_t> selected_;
-    bool counting_ = false;
-    std::exception_ptr scan_error_;  // damage the pass over the file met
 
     Fields fields_;
     std::vector<unsigned char> header_;
-    std::uint64_t pos_ = 0;
-    std::vector<unsigned char> rec_;
-    std::vector<unsigned char> raw_;
-    std::vector<unsigned char> chunk_;
-    std::size_t chunk_pos_ = 0;
-    bool in_chunk_ = false;
-    bool chunk_plain_ = false;
-    std::string chunk_method_;
-    std::uint64_t chunk_at_ = 0;
-    std::uint64_t chunk_data_at_ = 0;
-
-    BagMessage current_;
-    bool msg_ = false;
-    std::uint64_t index_ = 0;
 };
 
 }  // namespace

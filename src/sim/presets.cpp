@@ -43,8 +43,15 @@ json shape_objects(double s, double k, const json& profile) {
     return objs;
 }
 
-json base(int w, int h, double duration, int seed) {
-    return {{"sensor", {w, h}}, {"duration_s", duration}, {"seed", seed}};
+// A scene with its sensor, duration, seed, name, description and background, seen by the
+// usual camera (contrast 0.25, spread 0.03); the caller adds the objects.
+json scene(int w, int h, double duration, int seed, const char* name, const char* description, json background) {
+    json j = {{"sensor", {w, h}}, {"duration_s", duration}, {"seed", seed}};
+    j["name"] = name;
+    j["description"] = description;
+    j["camera"] = {{"contrast", 0.25}, {"contrast_sigma", 0.03}};
+    j["background"] = std::move(background);
+    return j;
 }
 
 json texture(double mean, double amplitude, double scale) {
@@ -58,31 +65,24 @@ json checkerboard(double x, double y, double sq, int cols, int rows, json motion
 }
 
 json scene_shapes() {
-    json j = base(240, 180, 6.0, 1);
-    j["name"] = "shapes";
-    j["description"] = "four shapes (one not convex) orbiting and spinning at 20-90 px/s over a faint texture";
-    j["camera"] = {{"contrast", 0.25}, {"contrast_sigma", 0.03}};
-    j["background"] = texture(0.5, 0.04, 24);
+    json j = scene(240, 180, 6.0, 1, "shapes",
+                   "four shapes (one not convex) orbiting and spinning at 20-90 px/s over a faint texture",
+                   texture(0.5, 0.04, 24));
     j["objects"] = shape_objects(1, 1, nullptr);
     return j;
 }
 
 json scene_checkerboard() {
-    json j = base(240, 180, 6.0, 2);
-    j["name"] = "checkerboard";
-    j["description"] = "a 7x5 checkerboard of 16 px squares turning at 45 deg/s and growing by 5 %/s";
-    j["camera"] = {{"contrast", 0.25}, {"contrast_sigma", 0.03}};
-    j["background"] = 0.5;
+    json j = scene(240, 180, 6.0, 2, "checkerboard",
+                   "a 7x5 checkerboard of 16 px squares turning at 45 deg/s and growing by 5 %/s", 0.5);
     j["objects"] = json::array({checkerboard(64, 50, 16, 7, 5, {{"rotation_deg_s", 45}, {"scaling_per_s", 0.05}})});
     return j;
 }
 
 json scene_polygons() {
-    json j = base(240, 180, 6.0, 3);
-    j["name"] = "polygons";
-    j["description"] = "16 random polygons (4-7 vertices, many not convex) orbiting at 15-120 px/s over a strong texture";
-    j["camera"] = {{"contrast", 0.25}, {"contrast_sigma", 0.03}};
-    j["background"] = texture(0.5, 0.25, 12);
+    json j = scene(240, 180, 6.0, 3, "polygons",
+                   "16 random polygons (4-7 vertices, many not convex) orbiting at 15-120 px/s over a strong texture",
+                   texture(0.5, 0.25, 12));
     Random rng(3, 0x9017);
     json objs = json::array();
     for (int i = 0; i < 16; ++i) {
@@ -107,11 +107,10 @@ json scene_polygons() {
 }
 
 json scene_ramp() {
-    json j = base(240, 180, 8.0, 4);
-    j["name"] = "ramp";
-    j["description"] = "the shapes and a small checkerboard turning faster and faster: corner speeds ramp from 0 to about 1000 px/s";
-    j["camera"] = {{"contrast", 0.25}, {"contrast_sigma", 0.03}};
-    j["background"] = texture(0.5, 0.04, 24);
+    json j = scene(240, 180, 8.0, 4, "ramp",
+                   "the shapes and a small checkerboard turning faster and faster: corner speeds ramp from 0 to about "
+                   "1000 px/s",
+                   texture(0.5, 0.04, 24));
     // The farthest corner (about 85 px from the centre) reaches 1000 px/s at 675 deg/s.
     const json ramp = {{"ramp", {{"from", 0.0}, {"to", 1.0}}}};
     json objs = json::array();
@@ -141,11 +140,9 @@ json scene_noisy() {
 }
 
 json scene_hd() {
-    json j = base(1280, 720, 5.0, 6);
-    j["name"] = "hd";
-    j["description"] = "1280x720: the shapes at 4x and a 9x6 checkerboard of 40 px squares, 30-400 px/s, over a texture";
-    j["camera"] = {{"contrast", 0.25}, {"contrast_sigma", 0.03}};
-    j["background"] = texture(0.5, 0.1, 64);
+    json j = scene(1280, 720, 5.0, 6, "hd",
+                   "1280x720: the shapes at 4x and a 9x6 checkerboard of 40 px squares, 30-400 px/s, over a texture",
+                   texture(0.5, 0.1, 64));
     json objs = shape_objects(4, 1, nullptr);
     // Shift the 960x720 layout to the middle of the wider sensor.
     for (json& o : objs) {
@@ -158,11 +155,10 @@ json scene_hd() {
 }
 
 json scene_square() {
-    json j = base(240, 180, 0.4, 0);
-    j["name"] = "square";
-    j["description"] = "the analytic test: a 40x40 square of 0.1 on 0.5 moving its own width at 100 px/s; 9600 ON, 9600 OFF";
-    j["camera"] = {{"contrast", 0.25}};
-    j["background"] = 0.5;
+    json j = scene(240, 180, 0.4, 0, "square",
+                   "the analytic test: a 40x40 square of 0.1 on 0.5 moving its own width at 100 px/s; 9600 ON, 9600 OFF",
+                   0.5);
+    j["camera"] = {{"contrast", 0.25}};  // no contrast spread
     j["objects"] = json::array(
         {{{"polygon", {{60, 70}, {100, 70}, {100, 110}, {60, 110}}}, {"intensity", 0.1}, {"motion", {{"velocity", {100, 0}}}}}});
     return j;
