@@ -3,7 +3,9 @@
     PYTHONPATH=build/python /usr/bin/python3 python/bench/measure.py build/bin/evcorner ../shared/data/real/ecd-stppp/*/events.txt
 
 Prints one line per figure; every ratio is a median of interleaved runs in the same process
-run. The machine load (uptime) is printed first and last.
+run. The machine load (uptime) is printed first and last. Detection is compared by CPU
+time (detection_ratio). REPS=5 (rounds), DETECTORS=efast,harris, ONLY=detect (stop after
+the detection figures).
 """
 
 import json
@@ -39,27 +41,59 @@ def replay(files, n):
     return np.concatenate(out)[:n]
 
 
+def cpu_s():
+    """This process's CPU time (user + system, all threads), s."""
+    return time.process_time()
+
+
+def detection_ratio(cli, big, events, det, reps, tmp):
+    """Python vs CLI detection time on the same 10 M events, by CPU time (the machine is
+    shared: wall time counts the time other processes hold the core). Interleaved, per
+    round: the CLI's `bench --cpu-time` (two passes over the file as it is, each a freshly
+    built detector, the thread's CPU time around detect() alone: the library's checked
+    call over the whole span), then two evcorner.detect(events, det) calls in Python (the
+    process's CPU time around the call, building the detector included). PIPELINE=1 adds
+    the CLI's `detect` pipeline (65 536-event batches; its detect_s is wall time)."""
+    js = os.path.join(tmp, "bench.json")
+    cli_ns, py_ns, pipe_ns = [], [], []
+    n = len(events)
+    for _ in range(reps):
+        subprocess.run([cli, "bench", big, "-d", det, "--repeat", "1", "--min-events", "1", "--no-latency",
+                        "--cpu-time", "--json", js, "-q"], check=True, stdout=subprocess.DEVNULL)
+        (row,) = json.load(open(js))["results"]
+        cli_ns += [row["cold_ns_per_event"][0], row["ns_per_event"][0]]
+        for _pass in range(2):
+            t0 = cpu_s()
+            evcorner.detect(events, det)
+            py_ns.append((cpu_s() - t0) * 1e9 / n)
+        line = f"  {det} round: CLI bench {cli_ns[-2]:.1f} {cli_ns[-1]:.1f}, Python detect() {py_ns[-2]:.1f} {py_ns[-1]:.1f}"
+        if os.environ.get("PIPELINE") == "1":
+            s = os.path.join(tmp, "s.json")
+            subprocess.run([cli, "detect", big, "-d", det, "-o", os.devnull, "--summary-json", s, "-q"], check=True)
+            pipe_ns.append(json.load(open(s))["detect_s"] * 1e9 / n)
+            line += f", CLI detect pipeline (wall) {pipe_ns[-1]:.1f}"
+        print(line + " ns/event", flush=True)
+    c, p = statistics.median(cli_ns), statistics.median(py_ns)
+    print(f"{det} on {n / 1e6:g} M events, CPU ns/event (medians of {len(cli_ns)} passes each, {reps} interleaved "
+          f"rounds): CLI bench --cpu-time {c:.1f}, Python evcorner.detect() {p:.1f}: Python/CLI {p / c:.3f}"
+          + (f"; CLI detect pipeline detect_s (wall) {statistics.median(pipe_ns):.1f}" if pipe_ns else ""),
+          flush=True)
+
 def main():
     cli, files = sys.argv[1], sys.argv[2:]
     reps = int(os.environ.get("REPS", "5"))
+    detectors = os.environ.get("DETECTORS", "efast,harris").split(",")
     print("load before:", uptime())
     tmp = tempfile.mkdtemp(prefix="evcorner-measure-")
     events = replay(files, 10_000_000)
     big = os.path.join(tmp, "replay10M.npy")
     evcorner.write(big, events)
 
-    for det in ("efast", "harris"):
-        cli_s, py_s = [], []
-        for _ in range(reps):  # interleaved
-            js = os.path.join(tmp, "s.json")
-            subprocess.run([cli, "detect", big, "-d", det, "-o", os.devnull, "--summary-json", js, "-q"], check=True)
-            cli_s.append(json.load(open(js))["detect_s"])
-            t0 = time.perf_counter()
-            evcorner.detect(events, det)
-            py_s.append(time.perf_counter() - t0)
-        c, p = statistics.median(cli_s), statistics.median(py_s)
-        print(f"{det} on 10 M events: CLI detection {c:.3f} s, Python detect() {p:.3f} s "
-              f"(incl. building the detector), Python/CLI {p / c:.3f} (medians of {reps})")
+    for det in detectors:
+        detection_ratio(cli, big, events, det, reps, tmp)
+    if os.environ.get("ONLY") == "detect":
+        print("load after:", uptime())
+        return
 
     det = evcorner.EFast(240, 180)
     one = events[:1].copy()

@@ -29,7 +29,7 @@ from ._evcorner import (
     reduction_rate,
 )
 from ._events import EventFile, as_events, open, read, write  # noqa: A004 (open, like io.open)
-from ._detectors import DETECTOR_CLASSES, detect, detect_file, detectors, label, simulate
+from ._detectors import DETECTOR_CLASSES, detect, detect_file, detectors, evaluate_truth, label, simulate
 
 __version__ = "0.1.0"
 
@@ -51,6 +51,7 @@ __all__ = [
     "detect",
     "detect_file",
     "detectors",
+    "evaluate_truth",
     "ft_percent",
     "label",
     "open",

@@ -2,6 +2,8 @@
 
 import os
 
+import numpy as np
+
 from . import _evcorner
 from ._evcorner import Detector
 from ._events import _input_path, _size, reader_options
@@ -97,3 +99,41 @@ def simulate(scene):
     if isinstance(scene, str) and scene.lstrip().startswith("{"):
         return _evcorner.simulate(scene, False)
     return _evcorner.simulate(_input_path(scene), True)
+
+
+def evaluate_truth(events, corners, truth, radius=3.5, tolerance_us=1000, credit="all", interpolation="linear",
+                   speed_bins=None):
+    """Corner events against a simulated scene's ground truth (the truth CSV of
+    ``evcorner simulate --truth``), as ``evcorner eval --truth`` judges them
+    (docs/evaluation.md, "Against ground truth"): precision, recall, localisation error.
+
+    `corners` is either the detector's uint8/bool mask over `events` (as detect() returns
+    it) or the corner events themselves (EVENT_DTYPE, time order; `events` may then be
+    None). The keywords are eval's options: radius = --match-radius (px), tolerance_us =
+    --match-tolerance (us), credit = --match-credit ("all"/"nearest"), interpolation =
+    --match-interpolation ("linear"/"nearest"), speed_bins = --speed-bins (edges in px/s,
+    from 0; None: 0,50,100,200,400,700). The truth is streamed, never all in memory; the GIL
+    is released while matching.
+
+    Returns a dict with the keys of results.json's "truth" object (truth, true_positives,
+    precision_percent, truth_samples, recalled, recall_percent, loc_median_px,
+    loc_mean_px, loc_p90_px, speed_bins) plus corner_events, events (len(events), or None),
+    is_true (uint8 per corner event) and errors (float32 px per true positive, in order)."""
+    if isinstance(corners, np.ndarray) and corners.dtype == _evcorner.EVENT_DTYPE:
+        corner_events = corners
+    else:
+        if events is None:
+            raise TypeError("evaluate_truth: a mask needs the events it marks (events=None)")
+        mask = np.asarray(corners)
+        if mask.ndim != 1 or mask.dtype not in (np.dtype(np.uint8), np.dtype(np.bool_)):
+            raise TypeError(f"evaluate_truth: corners must be a 1-D uint8/bool mask or EVENT_DTYPE corner events, "
+                            f"got {mask.dtype} with {mask.ndim} dimension(s)")
+        if len(mask) != len(events):
+            raise ValueError(f"evaluate_truth: the mask has {len(mask)} entries for {len(events)} events")
+        _evcorner._address(events)  # the same checks (dtype, stride) as every verb
+        corner_events = events[mask != 0]  # the corners only: one copy of a small part
+    bins = None if speed_bins is None else [float(b) for b in speed_bins]
+    r = _evcorner.evaluate_truth(corner_events, _input_path(truth), float(radius), int(tolerance_us), credit,
+                                 interpolation, bins)
+    r["events"] = None if events is None else len(events)
+    return r

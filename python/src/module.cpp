@@ -11,6 +11,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -26,6 +27,7 @@
 #include "evcorner/error.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/eval/metrics.hpp"
+#include "evcorner/eval/truth_match.hpp"
 #include "evcorner/event.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/io/event_reader.hpp"
@@ -36,6 +38,7 @@
 #include "evcorner/scored_detector.hpp"
 #include "evcorner/sim/scene.hpp"
 #include "evcorner/sim/simulator.hpp"
+#include "evcorner/sim/truth.hpp"
 #include "evcorner/state_memory.hpp"
 
 namespace py = pybind11;
@@ -478,6 +481,72 @@ py::tuple simulate_py(const std::string& scene, bool is_path) {
     return py::make_tuple(to_array(std::move(events)), py::make_tuple(size.width, size.height));
 }
 
+/// Corner events against a simulated scene's truth CSV, streamed one sample time at a time
+/// (sim::TruthReader -> eval::TruthMatcher), as `evcorner eval --truth` does: the dict holds
+/// the keys of results.json's "truth" object, plus corner_events and the per-event arrays.
+py::dict evaluate_truth_py(py::handle corners, const std::string& truth, double radius, std::int64_t tolerance_us,
+                           const std::string& credit, const std::string& interpolation,
+                           std::optional<std::vector<double>> speed_bins) {
+    const std::span<const Event> ev = events_view(corners, "corners");
+    eval::TruthMatchParams p;
+    p.radius = radius;
+    p.tolerance_us = tolerance_us;
+    pythonic_errors([&] {
+        p.credit = eval::parse_credit(credit);
+        p.interpolation = eval::parse_interpolation(interpolation);
+        if (speed_bins) p.speed_edges = std::move(*speed_bins);
+        eval::validate(p);
+    });
+    eval::TruthMatchResult r;
+    eval::ErrorSummary err;
+    {
+        py::gil_scoped_release release;
+        // The matcher takes a detector's output, in time order; anything else would be
+        // matched wrongly without a word, so it is refused here.
+        for (std::size_t i = 1; i < ev.size(); ++i)
+            if (ev[i].t < ev[i - 1].t)
+                throw std::invalid_argument("corners: not in time order at index " + std::to_string(i) + " (t " +
+                                            std::to_string(ev[i].t) + " us after " + std::to_string(ev[i - 1].t) +
+                                            " us)");
+        eval::TruthMatcher matcher(ev, p);
+        sim::TruthReader reader(truth);
+        std::vector<sim::TruthCorner> rows;
+        while (reader.next_sample(rows)) matcher.add_sample(rows);
+        r = matcher.finish();
+        err = eval::summarize_errors(r.errors);
+    }
+    py::dict d;
+    d["truth"] = truth;
+    d["corner_events"] = r.corner_events;
+    d["true_positives"] = r.true_positives;
+    d["precision_percent"] = r.precision();
+    d["truth_samples"] = r.truth_samples;
+    d["recalled"] = r.recalled;
+    d["recall_percent"] = r.recall();
+    d["loc_median_px"] = err.median;
+    d["loc_mean_px"] = err.mean;
+    d["loc_p90_px"] = err.p90;
+    py::list bins;
+    for (const eval::SpeedBin& b : r.bins) {
+        py::dict q;
+        q["speed_lo"] = b.lo;
+        q["speed_hi"] = std::isinf(b.hi) ? py::object(py::none()) : py::object(py::float_(b.hi));
+        q["events"] = b.events;
+        q["true_positives"] = b.true_positives;
+        q["samples"] = b.samples;
+        q["recalled"] = b.recalled;
+        bins.append(q);
+    }
+    d["speed_bins"] = bins;
+    py::array_t<std::uint8_t> is_true(static_cast<py::ssize_t>(r.is_true.size()));
+    std::copy(r.is_true.begin(), r.is_true.end(), is_true.mutable_data());
+    py::array_t<float> errors(static_cast<py::ssize_t>(r.errors.size()));
+    std::copy(r.errors.begin(), r.errors.end(), errors.mutable_data());
+    d["is_true"] = is_true;
+    d["errors"] = errors;
+    return d;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_evcorner, m) {
@@ -584,4 +653,15 @@ PYBIND11_MODULE(_evcorner, m) {
     m.def("reduction_rate", &eval::reduction_rate, py::arg("events"), py::arg("corners"));
     m.def("ft_percent", &eval::ft_percent, py::arg("corners"), py::arg("on_track"));
     m.def("simulate", &simulate_py, py::arg("scene"), py::arg("is_path"));
+    m.def(
+        "evaluate_truth",
+        [](py::handle corners, const std::string& truth, double radius, std::int64_t tolerance_us,
+           const std::string& credit, const std::string& interpolation, std::optional<std::vector<double>> speed_bins) {
+            return pythonic_errors([&] {
+                return evaluate_truth_py(corners, truth, radius, tolerance_us, credit, interpolation,
+                                         std::move(speed_bins));
+            });
+        },
+        py::arg("corners"), py::arg("truth"), py::arg("radius"), py::arg("tolerance_us"), py::arg("credit"),
+        py::arg("interpolation"), py::arg("speed_bins") = py::none());
 }
