@@ -43,27 +43,49 @@ struct ArcExtent {
 };
 
 // eFAST on one circle t[0..N): the shortest firing length in Lmin..Lmax and its margin.
+// The arc grows from the (first) newest pixel k towards the newer neighbour (ties: right),
+// Lmax steps at most, on a doubled copy of the circle (no modulo); at length L it fires
+// when its oldest is strictly newer than the rest's newest. The rest at length L is the
+// pixels that join later (g[L..Lmax)) and those that never join (one cyclic segment), so
+// the rest's newest for every L comes from suffix maxima of the joining order and one
+// scan: O(N) in all. A firing arc is the L newest pixels of the circle, so the first L
+// that fires is the definition's shortest (naive/scores_naive.hpp writes it plainly).
 template <int N, int Lmin, int Lmax>
 inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+    static_assert(1 <= Lmin && Lmin <= Lmax && Lmax < N);
+    std::int64_t d[2 * N];
+    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
     int k = 0;
     for (int i = 1; i < N; ++i)
         if (t[i] > t[k]) k = i;
-    // The arc [k-a, k+b] grows towards the newer neighbour (ties: right); the rest is the
-    // cyclic arc from k+b+1 to k-a-1.
+    // The arc is [k - a, k + b] (a + b + 1 pixels): its left neighbour is d[k + N - a - 1],
+    // its right one d[k + b + 1], both within d.
     int a = 0, b = 0;
-    std::int64_t oldest = t[k];
+    std::int64_t oldest[Lmax + 1];  // oldest[L]: the arc's oldest at length L
+    std::int64_t joined[Lmax + 1];  // joined[L]: the pixel that joins at length L
+    oldest[1] = t[k];
+    joined[1] = t[k];
     for (int len = 2; len <= Lmax; ++len) {
-        const std::int64_t l = t[(k - a - 1 + N) % N];
-        const std::int64_t r = t[(k + b + 1) % N];
+        const std::int64_t l = d[k + N - a - 1];
+        const std::int64_t r = d[k + b + 1];
         const bool go_left = l > r;
         a += go_left;
         b += !go_left;
-        oldest = std::min(oldest, go_left ? l : r);
-        if (len < Lmin) continue;
-        std::int64_t rest = INT64_MIN;
-        for (int j = b + 1; j < N - a; ++j) rest = std::max(rest, t[(k + j) % N]);
-        if (oldest > rest) return {len, time_margin(oldest, rest, now)};
+        const std::int64_t v = go_left ? l : r;
+        joined[len] = v;
+        oldest[len] = std::min(oldest[len - 1], v);
     }
+    // The pixels that never join: d[k + b + 1 .. k + N - a - 1], N - Lmax of them.
+    std::int64_t rest = INT64_MIN;
+    for (int j = k + b + 1; j < k + N - a; ++j) rest = std::max(rest, d[j]);
+    // From the longest arc down: rest_newest[L] = max(rest, joined[L + 1 .. Lmax]).
+    std::int64_t rest_newest[Lmax + 1];
+    for (int len = Lmax; len >= Lmin; --len) {
+        rest_newest[len] = rest;
+        rest = std::max(rest, joined[len]);
+    }
+    for (int len = Lmin; len <= Lmax; ++len)
+        if (oldest[len] > rest_newest[len]) return {len, time_margin(oldest[len], rest_newest[len], now)};
     return {};
 }
 
