@@ -89,22 +89,27 @@ inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexc
     return {};
 }
 
-// Arc* on one circle t[0..N): its growth (arcstar_test.hpp) written plainly, recording
-// the order in which pixels join, then min(size, N - size) and the margin of the final arc.
+// Arc* on one circle t[0..N): its growth (arcstar_test.hpp) written plainly on a doubled
+// copy of the circle (no modulo), recording the times in the order in which pixels join,
+// then min(size, N - size) and the margin of the final arc.
 template <int N, int Lmin>
 inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+    std::int64_t d[2 * N];
+    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
     int k = 0;
     for (int i = 1; i < N; ++i)
         if (t[i] > t[k]) k = i;
-    int order[N];
-    order[0] = k;
-    int cw = (k + 1) % N, ccw = (k - 1 + N) % N;
-    std::int64_t min_cw = t[cw], min_ccw = t[ccw];
+    std::int64_t joined[N];  // joined[i]: the time of the i-th pixel to join
+    joined[0] = t[k];
+    // The clockwise frontier d[cw] moves up from k + 1, the counter-clockwise one d[ccw]
+    // down from k + N - 1: both stay within d over the N - 1 steps.
+    int cw = k + 1, ccw = k + N - 1;
+    std::int64_t min_cw = d[cw], min_ccw = d[ccw];
     std::int64_t seg = t[k];
     int size = Lmin;
     for (int it = 1; it < N; ++it) {
-        const bool go_cw = t[cw] > t[ccw];
-        const std::int64_t v = go_cw ? t[cw] : t[ccw];
+        const bool go_cw = d[cw] > d[ccw];
+        const std::int64_t v = go_cw ? d[cw] : d[ccw];
         const std::int64_t side_min = go_cw ? min_cw : min_ccw;
         if (it < Lmin) {
             seg = std::min(seg, side_min);
@@ -112,19 +117,19 @@ inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noe
             size = it + 1;
             seg = std::min(seg, side_min);
         }
-        order[it] = go_cw ? cw : ccw;
+        joined[it] = v;
         if (go_cw) {
-            cw = (cw + 1) % N;
-            min_cw = std::min(min_cw, t[cw]);
+            ++cw;
+            min_cw = std::min(min_cw, d[cw]);
         } else {
-            ccw = (ccw - 1 + N) % N;
-            min_ccw = std::min(min_ccw, t[ccw]);
+            --ccw;
+            min_ccw = std::min(min_ccw, d[ccw]);
         }
     }
     std::int64_t in_oldest = INT64_MAX, out_newest = INT64_MIN;
     for (int i = 0; i < N; ++i) {
-        if (i < size) in_oldest = std::min(in_oldest, t[order[i]]);
-        else out_newest = std::max(out_newest, t[order[i]]);
+        if (i < size) in_oldest = std::min(in_oldest, joined[i]);
+        else out_newest = std::max(out_newest, joined[i]);
     }
     // A majority arc: the corner is the complement (older inside than the arc around it).
     const bool majority = 2 * size > N;
