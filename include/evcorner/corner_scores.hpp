@@ -42,29 +42,26 @@ struct ArcExtent {
     double margin = 0;   ///< time_margin of that arc
 };
 
-// eFAST on one circle t[0..N): the shortest firing length in Lmin..Lmax and its margin.
-// The arc grows from the (first) newest pixel k towards the newer neighbour (ties: right),
-// Lmax steps at most, on a doubled copy of the circle (no modulo); at length L it fires
-// when its oldest is strictly newer than the rest's newest. The rest at length L is the
-// pixels that join later (g[L..Lmax)) and those that never join (one cyclic segment), so
-// the rest's newest for every L comes from suffix maxima of the joining order and one
-// scan: O(N) in all. A firing arc is the L newest pixels of the circle, so the first L
-// that fires is the definition's shortest (naive/scores_naive.hpp writes it plainly).
+// eFAST on one circle: the shortest firing length in Lmin..Lmax and its margin, on the
+// doubled circle d[0..2N) (d[i] = d[i + N]: no modulo) with k its first newest pixel.
+// The arc grows from k towards the newer neighbour (ties: right), Lmax - 1 steps; at
+// length L it fires when its oldest is strictly newer than the rest's newest. The rest at
+// length L is the pixels that join later (joined[L + 1 .. Lmax]) and those that never join
+// (one cyclic segment), so the rest's newest for every L comes from suffix maxima of the
+// joining order and one scan: O(N) in all. A firing arc is the L newest pixels of the
+// circle, so the first L that fires is the definition's shortest (naive/scores_naive.hpp
+// writes it plainly).
 template <int N, int Lmin, int Lmax>
-inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+inline ArcExtent efast_arc_extent_doubled(const std::int64_t* d, int k, std::int64_t now) noexcept {
     static_assert(1 <= Lmin && Lmin <= Lmax && Lmax < N);
-    std::int64_t d[2 * N];
-    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
-    int k = 0;
-    for (int i = 1; i < N; ++i)
-        if (t[i] > t[k]) k = i;
     // The arc is [k - a, k + b] (a + b + 1 pixels): its left neighbour is d[k + N - a - 1],
     // its right one d[k + b + 1], both within d.
     int a = 0, b = 0;
     std::int64_t oldest[Lmax + 1];  // oldest[L]: the arc's oldest at length L
     std::int64_t joined[Lmax + 1];  // joined[L]: the pixel that joins at length L
-    oldest[1] = t[k];
-    joined[1] = t[k];
+    oldest[1] = d[k];
+    joined[1] = d[k];
+#pragma GCC unroll 8
     for (int len = 2; len <= Lmax; ++len) {
         const std::int64_t l = d[k + N - a - 1];
         const std::int64_t r = d[k + b + 1];
@@ -87,6 +84,17 @@ inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexc
     for (int len = Lmin; len <= Lmax; ++len)
         if (oldest[len] > rest_newest[len]) return {len, time_margin(oldest[len], rest_newest[len], now)};
     return {};
+}
+
+// The same on one circle t[0..N).
+template <int N, int Lmin, int Lmax>
+inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+    std::int64_t d[2 * N];
+    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
+    int k = 0;
+    for (int i = 1; i < N; ++i)
+        if (t[i] > t[k]) k = i;
+    return efast_arc_extent_doubled<N, Lmin, Lmax>(d, k, now);
 }
 
 // Arc* on one circle t[0..N): its growth (arcstar_test.hpp) written plainly on a doubled
@@ -142,6 +150,25 @@ inline void gather(const std::int64_t* centre, std::ptrdiff_t width, const Circl
     for (int k = 0; k < N; ++k) t[k] = centre[circle[k].dy * width + circle[k].dx];
 }
 
+// gather() into a doubled circle d[0..2N); returns the first newest pixel's index.
+template <int N, class Circle>
+inline int gather_doubled(const std::int64_t* centre, std::ptrdiff_t width, const Circle& circle,
+                          std::int64_t* d) noexcept {
+    int k = 0;
+    std::int64_t newest = INT64_MIN;
+#pragma GCC unroll 20
+    for (int i = 0; i < N; ++i) {
+        const std::int64_t v = centre[circle[i].dy * width + circle[i].dx];
+        d[i] = v;
+        d[i + N] = v;
+        if (v > newest) {
+            newest = v;
+            k = i;
+        }
+    }
+    return k;
+}
+
 inline double combine(ArcExtent c3, ArcExtent c4) noexcept {
     return static_cast<double>((16 - c3.length) + (20 - c4.length) - 15) + std::min(c3.margin, c4.margin);
 }
@@ -150,10 +177,11 @@ inline double combine(ArcExtent c3, ArcExtent c4) noexcept {
 /// eFAST's score of a corner event whose SAE cell is `centre` (stored form, row stride
 /// `width`), at stored time `now`. For a non-corner the value means nothing.
 inline double efast_score(const std::int64_t* centre, std::ptrdiff_t width, std::int64_t now) noexcept {
-    std::int64_t t3[16], t4[20];
-    detail::gather<16>(centre, width, kCircle3, t3);
-    detail::gather<20>(centre, width, kCircle4, t4);
-    return detail::combine(detail::efast_arc_extent<16, 3, 6>(t3, now), detail::efast_arc_extent<20, 4, 8>(t4, now));
+    std::int64_t d3[32], d4[40];
+    const int k3 = detail::gather_doubled<16>(centre, width, kCircle3, d3);
+    const int k4 = detail::gather_doubled<20>(centre, width, kCircle4, d4);
+    return detail::combine(detail::efast_arc_extent_doubled<16, 3, 6>(d3, k3, now),
+                           detail::efast_arc_extent_doubled<20, 4, 8>(d4, k4, now));
 }
 
 /// Arc*'s score of a corner event whose filtered-SAE cell is `centre`, at stored time `now`.
