@@ -7,7 +7,8 @@
 //   nms-d   detect(Suppressed<EFast>&, ...)  rule decay
 // Checks that the scored flags equal the binary ones on every pass. Prints per file the
 // median ns/event of each and, over the files, the median of the per-file ratios.
-// Usage: bench_nms [PASSES=15]
+// Usage: bench_nms [PASSES=15]; bench_nms once MODE FILE runs one loop once, for callgrind
+// (modes: load binary scored nms-w nms-d arc-binary arc-scored; see once()).
 
 #include <algorithm>
 #include <chrono>

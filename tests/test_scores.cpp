@@ -74,6 +74,22 @@ TEST(Scores, ArcStarScoresNeverChangeDecisions) {
         }
 }
 
+// A random circle of stored times at `now`: a contiguous newer run of random length over
+// an older background, times from `distinct` values each (ties), 0 (never fired) where the
+// draw is 0. Firing arcs of every length are common, not only by chance.
+template <int N>
+std::array<std::int64_t, N> random_circle(std::mt19937_64& rng, int distinct, std::int64_t now) {
+    std::array<std::int64_t, N> t{};
+    const int run = 1 + static_cast<int>(rng() % (N - 1));
+    const int at = static_cast<int>(rng() % N);
+    for (int i = 0; i < N; ++i) {
+        const bool in_run = (i - at + N) % N < run;
+        const std::int64_t v = static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(distinct));
+        t[static_cast<std::size_t>(i)] = v == 0 ? 0 : (in_run ? now - v : now - distinct - v);
+    }
+    return t;
+}
+
 // The fast arc extent of one circle (corner_scores.hpp: growth, suffix maxima) against the
 // definition tried plainly (naive/scores_naive.hpp): the same length and the same margin,
 // bit for bit, or no firing arc for both. Random circles from few distinct times (ties),
@@ -84,16 +100,7 @@ void expect_efast_extent_is_definition(std::uint64_t seed, int distinct) {
     int fired = 0;
     for (int trial = 0; trial < 20000; ++trial) {
         const std::int64_t now = 1000 + static_cast<std::int64_t>(rng() % 100);
-        std::array<std::int64_t, N> t{};
-        // A contiguous newer run of random length over a random background: firing arcs
-        // of every length are common, not only by chance.
-        const int run = 1 + static_cast<int>(rng() % (N - 1));
-        const int at = static_cast<int>(rng() % N);
-        for (int i = 0; i < N; ++i) {
-            const bool in_run = (i - at + N) % N < run;
-            const std::int64_t v = static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(distinct));
-            t[static_cast<std::size_t>(i)] = v == 0 ? 0 : (in_run ? now - v : now - distinct - v);
-        }
+        const std::array<std::int64_t, N> t = random_circle<N>(rng, distinct, now);
         const auto want = naive::shortest_firing_arc(t, Lmin, Lmax, now);
         const detail::ArcExtent got = detail::efast_arc_extent<N, Lmin, Lmax>(t.data(), now);
         ASSERT_EQ(got.length, want ? want->length : 0) << "seed " << seed << " trial " << trial;
@@ -121,14 +128,7 @@ void expect_arcstar_extent_is_growth(std::uint64_t seed, int distinct) {
     int with_margin = 0, without = 0;
     for (int trial = 0; trial < 20000; ++trial) {
         const std::int64_t now = 1000 + static_cast<std::int64_t>(rng() % 100);
-        std::array<std::int64_t, N> t{};
-        const int run = 1 + static_cast<int>(rng() % (N - 1));
-        const int at = static_cast<int>(rng() % N);
-        for (int i = 0; i < N; ++i) {
-            const bool in_run = (i - at + N) % N < run;
-            const std::int64_t v = static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(distinct));
-            t[static_cast<std::size_t>(i)] = v == 0 ? 0 : (in_run ? now - v : now - distinct - v);
-        }
+        const std::array<std::int64_t, N> t = random_circle<N>(rng, distinct, now);
         const naive::ArcFound want = naive::arcstar_arc_naive(t, Lmin, now);
         const detail::ArcExtent got = detail::arcstar_arc_extent<N, Lmin>(t.data(), now);
         ASSERT_EQ(got.length, want.length) << "seed " << seed << " trial " << trial;
