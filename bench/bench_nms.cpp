@@ -7,7 +7,8 @@
 //   nms-d   detect(Suppressed<EFast>&, ...)  rule decay
 // Checks that the scored flags equal the binary ones on every pass. Prints per file the
 // median ns/event of each and, over the files, the median of the per-file ratios.
-// Usage: bench_nms [PASSES=15]
+// Usage: bench_nms [PASSES=15]; bench_nms once MODE FILE runs one loop once, for callgrind
+// (modes: load binary scored nms-w nms-d arc-binary arc-scored; see once()).
 
 #include <algorithm>
 #include <chrono>
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "evcorner/arcstar.hpp"
 #include "evcorner/efast.hpp"
 #include "evcorner/nms.hpp"
 #include "real_files.hpp"
@@ -33,7 +35,8 @@ using Clock = std::chrono::steady_clock;
 }  // namespace
 
 // One loop once over one file, for callgrind: bench_nms once load|binary|scored|nms-w|nms-d FILE
-// (instructions per event = (I(mode) - I(load)) / events).
+// (instructions per event = (I(mode) - I(load)) / events); arc-binary|arc-scored: the same
+// for Arc* (default parameters, detect(ArcStar&, ...) without and with scores).
 int once(const std::string& mode, const std::string& file) {
     const std::vector<Event> ev = bench::load_events(file);
     std::vector<std::uint8_t> f(ev.size());
@@ -47,6 +50,12 @@ int once(const std::string& mode, const std::string& file) {
         c = detect(det, ev, f);
     } else if (mode == "scored") {
         EFast det(kDavis240);
+        c = detect(det, ev, f, sc);
+    } else if (mode == "arc-binary") {
+        ArcStar det(kDavis240);
+        c = detect(det, ev, f);
+    } else if (mode == "arc-scored") {
+        ArcStar det(kDavis240);
         c = detect(det, ev, f, sc);
     } else if (mode == "nms-w" || mode == "nms-d") {
         Suppressed<EFast> det(EFast(kDavis240), mode == "nms-w" ? NmsParams{} : d);

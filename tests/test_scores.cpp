@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "evcorner/efast.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/text_reader.hpp"
+#include "evcorner/naive/scores_naive.hpp"
 #include "evcorner/pipeline/detect.hpp"
 #include "evcorner/registry.hpp"
 #include "evcorner/scored_detector.hpp"
@@ -70,6 +72,105 @@ TEST(Scores, ArcStarScoresNeverChangeDecisions) {
                                                   "arcstar variant " + std::to_string(variant) + " seed " +
                                                       std::to_string(seed));
         }
+}
+
+// A random circle of stored times at `now`: a contiguous newer run of random length over
+// an older background, times from `distinct` values each (ties), 0 (never fired) where the
+// draw is 0. Firing arcs of every length are common, not only by chance.
+template <int N>
+std::array<std::int64_t, N> random_circle(std::mt19937_64& rng, int distinct, std::int64_t now) {
+    std::array<std::int64_t, N> t{};
+    const int run = 1 + static_cast<int>(rng() % (N - 1));
+    const int at = static_cast<int>(rng() % N);
+    for (int i = 0; i < N; ++i) {
+        const bool in_run = (i - at + N) % N < run;
+        const std::int64_t v = static_cast<std::int64_t>(rng() % static_cast<std::uint64_t>(distinct));
+        t[static_cast<std::size_t>(i)] = v == 0 ? 0 : (in_run ? now - v : now - distinct - v);
+    }
+    return t;
+}
+
+// The fast arc extent of one circle (corner_scores.hpp: growth, suffix maxima) against the
+// definition tried plainly (naive/scores_naive.hpp): the same length and the same margin,
+// bit for bit, or no firing arc for both. Random circles from few distinct times (ties),
+// with never-fired pixels (0) and the event's time.
+template <int N, int Lmin, int Lmax>
+void expect_efast_extent_is_definition(std::uint64_t seed, int distinct) {
+    std::mt19937_64 rng(seed);
+    int fired = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const std::int64_t now = 1000 + static_cast<std::int64_t>(rng() % 100);
+        const std::array<std::int64_t, N> t = random_circle<N>(rng, distinct, now);
+        const auto want = naive::shortest_firing_arc(t, Lmin, Lmax, now);
+        const detail::ArcExtent got = detail::efast_arc_extent<N, Lmin, Lmax>(t.data(), now);
+        ASSERT_EQ(got.length, want ? want->length : 0) << "seed " << seed << " trial " << trial;
+        if (want) {
+            ++fired;
+            ASSERT_EQ(got.margin, want->margin) << "seed " << seed << " trial " << trial;
+        }
+    }
+    EXPECT_GT(fired, 1000) << "too few firing circles to compare";
+}
+
+TEST(Scores, EFastArcExtentIsTheDefinition) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed)
+        for (const int distinct : {3, 8, 1000}) {
+            expect_efast_extent_is_definition<16, 3, 6>(seed, distinct);
+            expect_efast_extent_is_definition<20, 4, 8>(seed, distinct);
+        }
+}
+
+// Arc*'s fast arc extent (doubled circle, times recorded as they join) against its growth
+// written with cyclic indices (naive/scores_naive.hpp): same length and margin, bit for bit.
+template <int N, int Lmin>
+void expect_arcstar_extent_is_growth(std::uint64_t seed, int distinct) {
+    std::mt19937_64 rng(seed);
+    int with_margin = 0, without = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const std::int64_t now = 1000 + static_cast<std::int64_t>(rng() % 100);
+        const std::array<std::int64_t, N> t = random_circle<N>(rng, distinct, now);
+        const naive::ArcFound want = naive::arcstar_arc_naive(t, Lmin, now);
+        const detail::ArcExtent got = detail::arcstar_arc_extent<N, Lmin>(t.data(), now);
+        ASSERT_EQ(got.length, want.length) << "seed " << seed << " trial " << trial;
+        ASSERT_EQ(got.margin, want.margin) << "seed " << seed << " trial " << trial;
+        (want.margin > 0 ? with_margin : without) += 1;
+    }
+    EXPECT_GT(with_margin, 1000);
+    EXPECT_GT(without, 1000);
+}
+
+TEST(Scores, ArcStarArcExtentIsTheGrowth) {
+    for (std::uint64_t seed = 1; seed <= 3; ++seed)
+        for (const int distinct : {3, 8, 1000}) {
+            expect_arcstar_extent_is_growth<16, 3>(seed, distinct);
+            expect_arcstar_extent_is_growth<20, 4>(seed, distinct);
+        }
+}
+
+// eFAST's scored run against the score computed plainly from its SAE after each event.
+TEST(Scores, EFastScoresAreTheNaiveDefinition) {
+    const SensorSize z{64, 48};
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        const auto ev = test::arcstar_stream(z, 60000, seed, 40, 60000);
+        EFast det(z);
+        std::size_t corners = 0;
+        for (std::size_t i = 0; i < ev.size(); ++i) {
+            double s = 0;
+            const bool c = process_scored_unchecked(det, ev[i], s);
+            const std::int64_t* plane = det.sae().plane(ev[i].p);
+            const auto cell = [&](int dx, int dy) { return plane[(ev[i].y + dy) * z.width + ev[i].x + dx]; };
+            if (!c) continue;
+            ++corners;
+            std::array<std::int64_t, 16> c3;
+            std::array<std::int64_t, 20> c4;
+            for (int k = 0; k < 16; ++k) c3[static_cast<std::size_t>(k)] = cell(kCircle3[k].dx, kCircle3[k].dy);
+            for (int k = 0; k < 20; ++k) c4[static_cast<std::size_t>(k)] = cell(kCircle4[k].dx, kCircle4[k].dy);
+            const auto want = naive::efast_score_naive(c3, c4, Sae::stored(ev[i].t));
+            ASSERT_TRUE(want.has_value()) << "seed " << seed << " event " << i;
+            ASSERT_EQ(s, *want) << "seed " << seed << " event " << i;
+        }
+        EXPECT_GT(corners, 100u) << "seed " << seed;
+    }
 }
 
 TEST(Scores, GoldenFilesUnchangedByScoredPaths) {

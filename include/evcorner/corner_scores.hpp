@@ -42,47 +42,82 @@ struct ArcExtent {
     double margin = 0;   ///< time_margin of that arc
 };
 
-// eFAST on one circle t[0..N): the shortest firing length in Lmin..Lmax and its margin.
+// eFAST on one circle: the shortest firing length in Lmin..Lmax and its margin, on the
+// doubled circle d[0..2N) (d[i] = d[i + N]: no modulo) with k its first newest pixel.
+// The arc grows from k towards the newer neighbour (ties: right), Lmax - 1 steps; at
+// length L it fires when its oldest is strictly newer than the rest's newest. The rest at
+// length L is the pixels that join later (joined[L + 1 .. Lmax]) and those that never join
+// (one cyclic segment), so the rest's newest for every L comes from suffix maxima of the
+// joining order and one scan: O(N) in all. A firing arc is the L newest pixels of the
+// circle, so the first L that fires is the definition's shortest (naive/scores_naive.hpp
+// writes it plainly).
 template <int N, int Lmin, int Lmax>
-inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
-    int k = 0;
-    for (int i = 1; i < N; ++i)
-        if (t[i] > t[k]) k = i;
-    // The arc [k-a, k+b] grows towards the newer neighbour (ties: right); the rest is the
-    // cyclic arc from k+b+1 to k-a-1.
+inline ArcExtent efast_arc_extent_doubled(const std::int64_t* d, int k, std::int64_t now) noexcept {
+    static_assert(1 <= Lmin && Lmin <= Lmax && Lmax < N);
+    // The arc is [k - a, k + b] (a + b + 1 pixels): its left neighbour is d[k + N - a - 1],
+    // its right one d[k + b + 1], both within d.
     int a = 0, b = 0;
-    std::int64_t oldest = t[k];
+    std::int64_t oldest[Lmax + 1];  // oldest[L]: the arc's oldest at length L
+    std::int64_t joined[Lmax + 1];  // joined[L]: the pixel that joins at length L
+    oldest[1] = d[k];
+    joined[1] = d[k];
+#pragma GCC unroll 8
     for (int len = 2; len <= Lmax; ++len) {
-        const std::int64_t l = t[(k - a - 1 + N) % N];
-        const std::int64_t r = t[(k + b + 1) % N];
+        const std::int64_t l = d[k + N - a - 1];
+        const std::int64_t r = d[k + b + 1];
         const bool go_left = l > r;
         a += go_left;
         b += !go_left;
-        oldest = std::min(oldest, go_left ? l : r);
-        if (len < Lmin) continue;
-        std::int64_t rest = INT64_MIN;
-        for (int j = b + 1; j < N - a; ++j) rest = std::max(rest, t[(k + j) % N]);
-        if (oldest > rest) return {len, time_margin(oldest, rest, now)};
+        const std::int64_t v = go_left ? l : r;
+        joined[len] = v;
+        oldest[len] = std::min(oldest[len - 1], v);
     }
+    // The pixels that never join: d[k + b + 1 .. k + N - a - 1], N - Lmax of them.
+    std::int64_t rest = INT64_MIN;
+    for (int j = k + b + 1; j < k + N - a; ++j) rest = std::max(rest, d[j]);
+    // From the longest arc down: rest_newest[L] = max(rest, joined[L + 1 .. Lmax]).
+    std::int64_t rest_newest[Lmax + 1];
+    for (int len = Lmax; len >= Lmin; --len) {
+        rest_newest[len] = rest;
+        rest = std::max(rest, joined[len]);
+    }
+    for (int len = Lmin; len <= Lmax; ++len)
+        if (oldest[len] > rest_newest[len]) return {len, time_margin(oldest[len], rest_newest[len], now)};
     return {};
 }
 
-// Arc* on one circle t[0..N): its growth (arcstar_test.hpp) written plainly, recording
-// the order in which pixels join, then min(size, N - size) and the margin of the final arc.
-template <int N, int Lmin>
-inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+// The same on one circle t[0..N).
+template <int N, int Lmin, int Lmax>
+inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+    std::int64_t d[2 * N];
+    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
     int k = 0;
     for (int i = 1; i < N; ++i)
         if (t[i] > t[k]) k = i;
-    int order[N];
-    order[0] = k;
-    int cw = (k + 1) % N, ccw = (k - 1 + N) % N;
-    std::int64_t min_cw = t[cw], min_ccw = t[ccw];
+    return efast_arc_extent_doubled<N, Lmin, Lmax>(d, k, now);
+}
+
+// Arc* on one circle t[0..N): its growth (arcstar_test.hpp) written plainly on a doubled
+// copy of the circle (no modulo), recording the times in the order in which pixels join,
+// then min(size, N - size) and the margin of the final arc.
+template <int N, int Lmin>
+inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
+    std::int64_t d[2 * N];
+    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
+    int k = 0;
+    for (int i = 1; i < N; ++i)
+        if (t[i] > t[k]) k = i;
+    std::int64_t joined[N];  // joined[i]: the time of the i-th pixel to join
+    joined[0] = t[k];
+    // The clockwise frontier d[cw] moves up from k + 1, the counter-clockwise one d[ccw]
+    // down from k + N - 1: both stay within d over the N - 1 steps.
+    int cw = k + 1, ccw = k + N - 1;
+    std::int64_t min_cw = d[cw], min_ccw = d[ccw];
     std::int64_t seg = t[k];
     int size = Lmin;
     for (int it = 1; it < N; ++it) {
-        const bool go_cw = t[cw] > t[ccw];
-        const std::int64_t v = go_cw ? t[cw] : t[ccw];
+        const bool go_cw = d[cw] > d[ccw];
+        const std::int64_t v = go_cw ? d[cw] : d[ccw];
         const std::int64_t side_min = go_cw ? min_cw : min_ccw;
         if (it < Lmin) {
             seg = std::min(seg, side_min);
@@ -90,19 +125,19 @@ inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noe
             size = it + 1;
             seg = std::min(seg, side_min);
         }
-        order[it] = go_cw ? cw : ccw;
+        joined[it] = v;
         if (go_cw) {
-            cw = (cw + 1) % N;
-            min_cw = std::min(min_cw, t[cw]);
+            ++cw;
+            min_cw = std::min(min_cw, d[cw]);
         } else {
-            ccw = (ccw - 1 + N) % N;
-            min_ccw = std::min(min_ccw, t[ccw]);
+            --ccw;
+            min_ccw = std::min(min_ccw, d[ccw]);
         }
     }
     std::int64_t in_oldest = INT64_MAX, out_newest = INT64_MIN;
     for (int i = 0; i < N; ++i) {
-        if (i < size) in_oldest = std::min(in_oldest, t[order[i]]);
-        else out_newest = std::max(out_newest, t[order[i]]);
+        if (i < size) in_oldest = std::min(in_oldest, joined[i]);
+        else out_newest = std::max(out_newest, joined[i]);
     }
     // A majority arc: the corner is the complement (older inside than the arc around it).
     const bool majority = 2 * size > N;
@@ -115,6 +150,25 @@ inline void gather(const std::int64_t* centre, std::ptrdiff_t width, const Circl
     for (int k = 0; k < N; ++k) t[k] = centre[circle[k].dy * width + circle[k].dx];
 }
 
+// gather() into a doubled circle d[0..2N); returns the first newest pixel's index.
+template <int N, class Circle>
+inline int gather_doubled(const std::int64_t* centre, std::ptrdiff_t width, const Circle& circle,
+                          std::int64_t* d) noexcept {
+    int k = 0;
+    std::int64_t newest = INT64_MIN;
+#pragma GCC unroll 20
+    for (int i = 0; i < N; ++i) {
+        const std::int64_t v = centre[circle[i].dy * width + circle[i].dx];
+        d[i] = v;
+        d[i + N] = v;
+        if (v > newest) {
+            newest = v;
+            k = i;
+        }
+    }
+    return k;
+}
+
 inline double combine(ArcExtent c3, ArcExtent c4) noexcept {
     return static_cast<double>((16 - c3.length) + (20 - c4.length) - 15) + std::min(c3.margin, c4.margin);
 }
@@ -123,10 +177,11 @@ inline double combine(ArcExtent c3, ArcExtent c4) noexcept {
 /// eFAST's score of a corner event whose SAE cell is `centre` (stored form, row stride
 /// `width`), at stored time `now`. For a non-corner the value means nothing.
 inline double efast_score(const std::int64_t* centre, std::ptrdiff_t width, std::int64_t now) noexcept {
-    std::int64_t t3[16], t4[20];
-    detail::gather<16>(centre, width, kCircle3, t3);
-    detail::gather<20>(centre, width, kCircle4, t4);
-    return detail::combine(detail::efast_arc_extent<16, 3, 6>(t3, now), detail::efast_arc_extent<20, 4, 8>(t4, now));
+    std::int64_t d3[32], d4[40];
+    const int k3 = detail::gather_doubled<16>(centre, width, kCircle3, d3);
+    const int k4 = detail::gather_doubled<20>(centre, width, kCircle4, d4);
+    return detail::combine(detail::efast_arc_extent_doubled<16, 3, 6>(d3, k3, now),
+                           detail::efast_arc_extent_doubled<20, 4, 8>(d4, k4, now));
 }
 
 /// Arc*'s score of a corner event whose filtered-SAE cell is `centre`, at stored time `now`.

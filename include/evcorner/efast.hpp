@@ -7,6 +7,7 @@
 // pixels all strictly newer than the rest of the circle, and the radius-4 circle one
 // of 4..8 pixels (docs/efast.md gives the exact definition).
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -95,16 +96,23 @@ public:
         return View::template make<ScalarSearch>(sae_).template process_scored<ScalarSearch>(e, score);
     }
 
-    /// run_unchecked() with scores (score[i] as process_scored_unchecked() writes it).
+    /// run_unchecked() with scores (score[i] as process_scored_unchecked() writes it). The
+    /// scores start as NaN in one pass; the loop is run_unchecked()'s plus, for a corner
+    /// only, a call to the score (out of line, so that the per-event path stays the
+    /// binary one's).
     template <class Search>
     std::size_t run_scored_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner,
                                      std::span<double> score) noexcept {
         const View v = View::template make<Search>(sae_);
+        std::fill_n(score.begin(), events.size(), kNoScore);
         std::size_t corners = 0;
         for (std::size_t i = 0; i < events.size(); ++i) {
-            const bool c = v.template process_scored<Search>(events[i], score[i]);
+            const Event& e = events[i];
+            const bool c = v.template process<Search>(e);
             is_corner[i] = static_cast<std::uint8_t>(c);
             corners += c;
+            if (c) [[unlikely]]
+                score[i] = v.score(e);
         }
         return corners;
     }
@@ -163,14 +171,17 @@ private:
             }
         }
 
-        // process() and, for a corner, its score from the SAE just updated.
+        // The score of a corner event `e` from the SAE just updated with it.
+        [[gnu::noinline]] double score(const Event& e) const noexcept {
+            return efast_score(plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x, width,
+                               Sae::stored(e.t));
+        }
+
+        // process() and, for a corner, its score.
         template <class Search>
-        bool process_scored(const Event& e, double& score) const noexcept {
+        bool process_scored(const Event& e, double& s) const noexcept {
             const bool c = process<Search>(e);
-            score = kNoScore;
-            if (c)
-                score = efast_score(plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x, width,
-                                    Sae::stored(e.t));
+            s = c ? score(e) : kNoScore;
             return c;
         }
     };
