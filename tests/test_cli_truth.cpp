@@ -53,7 +53,7 @@ TEST_F(EvalTruthCli, PrecisionAndRecallAgreeWithTheOracle) {
     ASSERT_GT(want.recalled, 0u);
     const std::string row = csv.substr(csv.find("\nscene,efast,") + 1);
     const auto f = split(row.substr(0, row.find('\n')));
-    ASSERT_EQ(f.size(), 15u) << row;
+    ASSERT_EQ(f.size(), 17u) << row;  // ..., us_per_event, average_precision, smear
     EXPECT_EQ(f[3], std::to_string(corners.size()));
     EXPECT_EQ(f[4], std::to_string(want.true_positives));
     EXPECT_EQ(f[6], std::to_string(want.truth_samples));
@@ -97,6 +97,52 @@ TEST_F(EvalTruthCli, SuiteFolderFindsEachTruthBesideItsEvents) {
     ASSERT_NE(b, std::string::npos) << r.out;
     EXPECT_NE(r.out.find("\nwide "), std::string::npos) << r.out;
     EXPECT_EQ(r.out.substr(a + 2, r.out.find('\n', a + 1) - a - 2), r.out.substr(b + 2, r.out.find('\n', b + 1) - b - 2));
+}
+
+// PR curves and NMS in eval: --compare-nms gives NAME and NAME+nms rows; the +nms row's
+// corners are those of `detect --nms`; the PR curve's lowest threshold is the table's row.
+TEST_F(EvalTruthCli, CompareNmsAndPrCurve) {
+    write("scene.json", kScene);
+    ASSERT_EQ(run("simulate scene.json -o scene.npy --truth scene.truth.csv -q").status, 0);
+    const CliResult r = run("eval scene.npy -d efast --compare-nms --nms-radius 2 --nms-time 2000 --repeat 1 -q "
+                            "--report rep");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("Mean over the sequences"), std::string::npos) << r.out;
+    const std::string csv = slurp(dir_ / "rep/truth_table.csv");
+    ASSERT_EQ(count_lines(csv), 3u) << csv;
+    const auto field = [&](const std::string& det) {
+        const std::string row = csv.substr(csv.find("\nscene," + det + ",") + 1);
+        return split(row.substr(0, row.find('\n')));
+    };
+    const auto plain = field("efast"), nms = field("efast+nms");
+    ASSERT_EQ(plain.size(), 17u);
+    ASSERT_EQ(nms.size(), 17u);
+    ASSERT_EQ(run("detect scene.npy -d efast --nms --nms-radius 2 --nms-time 2000 -o kept.txt").status, 0);
+    EXPECT_EQ(nms[3], std::to_string(count_lines(slurp(dir_ / "kept.txt"))));
+    EXPECT_LT(std::stoull(nms[3]), std::stoull(plain[3]));
+    for (const auto& f : {plain, nms}) {
+        const double ap = std::stod(f[15]);
+        EXPECT_GT(ap, 0.0);
+        EXPECT_LE(ap, std::stod(f[8]) / 100 + 1e-9);  // AP <= full recall
+    }
+    // The last point of each curve (every corner event) is the row's precision and recall.
+    const std::string pr = slurp(dir_ / "rep/pr_curve.csv");
+    for (const auto& f : {plain, nms}) {
+        const std::string key = "scene," + f[1] + ",";
+        std::string last;
+        for (std::size_t at = pr.find("\n" + key); at != std::string::npos; at = pr.find("\n" + key, at + 1))
+            last = pr.substr(at + 1, pr.find('\n', at + 1) - at - 1);
+        ASSERT_FALSE(last.empty()) << pr;
+        const auto g = split(last);
+        EXPECT_NEAR(std::stod(g[3]), std::stod(f[5]), 1e-3) << last;
+        EXPECT_NEAR(std::stod(g[4]), std::stod(f[8]), 1e-3) << last;
+    }
+    EXPECT_TRUE(fs::exists(dir_ / "rep/figures/scene.pr.png"));
+    const auto j = nlohmann::json::parse(slurp(dir_ / "rep/results.json"));
+    EXPECT_EQ(j["nms"]["radius"], 2);
+    EXPECT_TRUE(j["runs"][1]["truth"]["average_precision"].is_number());
+    // --nms and --compare-nms together: usage.
+    EXPECT_EQ(run("eval scene.npy -d efast --nms --compare-nms --repeat 1 -q").status, 2);
 }
 
 TEST_F(EvalTruthCli, Errors) {

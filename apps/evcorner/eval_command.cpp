@@ -17,6 +17,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <set>
 #include <nlohmann/json.hpp>
@@ -29,8 +30,11 @@
 #include "eval_common.hpp"
 #include "evcorner/registry.hpp"
 #include "evcorner/detector.hpp"
+#include "evcorner/nms.hpp"
+#include "evcorner/scored_detector.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/eval/metrics.hpp"
+#include "evcorner/eval/pr_curve.hpp"
 #include "evcorner/eval/truth_match.hpp"
 #include "evcorner/render/charts.hpp"
 #include "evcorner/sim/truth.hpp"
@@ -65,6 +69,17 @@ struct EvalOptions {
     std::string credit = "all";
     std::string interpolation = "linear";
     std::vector<double> speed_edges;
+    // Non-maximum suppression (nms.hpp): every detector with it, or with and without.
+    bool nms = false, compare_nms = false;
+    NmsParams nms_params;
+    std::string nms_rule = "window";
+};
+
+// One evaluated kind: a detector, with or without NMS after it ("NAME+nms").
+struct EvalKind {
+    DetectorConfig config;
+    std::optional<NmsParams> nms;
+    std::string name;
 };
 
 struct Sequence {
@@ -326,7 +341,28 @@ struct DetectorRuns {
     std::vector<AnyDetector> detectors;
     std::vector<double> seconds;  ///< per detector: the sum of its batch calls
     std::vector<Event> corners;   ///< the first detector's corner events
+    std::vector<std::unique_ptr<AsyncNms>> nms;  ///< per detector with NMS, else empty
+    bool scored = false;          ///< the first detector runs scored (NMS, or a truth's PR curve)
+    std::vector<double> scores;   ///< then: its corner events' scores
 };
+
+// One batch through detector `d` (scored when `score` is not empty), then NMS when given.
+void detect_batch(AnyDetector& d, AsyncNms* nms, std::span<const Event> events, std::span<std::uint8_t> flags,
+                  std::span<double> score) {
+    if (score.empty()) {
+        detect(d, events, flags);
+        return;
+    }
+    std::visit(
+        [&](auto& det) {
+            if constexpr (ScoredDetector<std::remove_cvref_t<decltype(det)>>)
+                detect(det, events, flags, score);
+            else
+                detect(det, events, flags);  // not reached: has_score() is checked first
+        },
+        d);
+    if (nms) nms->filter(events, flags, score);
+}
 
 std::string cell(double v) { return std::isnan(v) ? "-" : fmt::format("{:.1f}", v); }
 
@@ -367,9 +403,9 @@ std::string table2_text(const eval::Table2& t, bool markdown) {
         for (const auto& r : t) s += fmt::format("| {} | {:.3f} | {:.0f} |\n", r.detector, r.us_per_event, r.max_event_rate);
         return s;
     }
-    s += fmt::format("{:<14}  {:>20}  {:>22}\n", "detector", "time per event [us]", "max. event rate [e/s]");
+    s += fmt::format("{:<18}  {:>20}  {:>22}\n", "detector", "time per event [us]", "max. event rate [e/s]");
     for (const auto& r : t)
-        s += fmt::format("{:<14}  {:>20.3f}  {:>22.0f}\n", r.detector, r.us_per_event, r.max_event_rate);
+        s += fmt::format("{:<18}  {:>20.3f}  {:>22.0f}\n", r.detector, r.us_per_event, r.max_event_rate);
     return s;
 }
 
@@ -438,7 +474,12 @@ struct TruthRow {
     double detect_s = 0;
     eval::TruthMatchResult m;
     eval::ErrorSummary err;
+    eval::PrCurve pr;  ///< empty points when the detector ran unscored
 };
+
+std::string ap_cell(const TruthRow& r, int digits = 3) {
+    return r.pr.points.empty() ? std::string("-") : fmt::format("{:.{}f}", r.pr.average_precision, digits);
+}
 
 std::string speed_bin_label(const eval::SpeedBin& b) {
     return std::isinf(b.hi) ? fmt::format("{:g}+", b.lo) : fmt::format("{:g}-{:g}", b.lo, b.hi);
@@ -451,37 +492,94 @@ double us_per_event(const TruthRow& r) {
 std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown) {
     std::string s;
     if (markdown) {
-        s += "| sequence | detector | corner events | precision % | recall % | loc. median px | loc. mean px | "
-             "loc. p90 px | Red. % | FT % | time/event us |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        s += "| sequence | detector | corner events | precision % | recall % | AP | loc. median px | loc. mean px | "
+             "loc. p90 px | Red. % | smear /corner/ms | FT % | time/event us |\n"
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const auto& r : rows)
-            s += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.1f} | {:.3f} |\n",
-                             r.sequence, r.detector, r.corners, r.m.precision(), r.m.recall(), r.err.median,
-                             r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners),
+            s += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} | {:.1f} | "
+                             "{:.3f} |\n",
+                             r.sequence, r.detector, r.corners, r.m.precision(), r.m.recall(), ap_cell(r), r.err.median,
+                             r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners), r.m.smear(),
                              eval::ft_percent(r.corners, r.on_track), us_per_event(r));
         return s;
     }
     std::size_t w = 8;
     for (const auto& r : rows) w = std::max(w, r.sequence.size());
-    s += fmt::format("{:<{}}  {:<14} {:>9} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>8}\n", "sequence", w, "detector",
-                     "corners", "P %", "R %", "med px", "mean", "p90", "Red.%", "FT %", "us/ev");
+    s += fmt::format("{:<{}}  {:<18} {:>9} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>8}\n", "sequence", w,
+                     "detector", "corners", "P %", "R %", "AP", "med px", "mean", "p90", "Red.%", "smear", "FT %",
+                     "us/ev");
     for (const auto& r : rows)
-        s += fmt::format("{:<{}}  {:<14} {:>9} {:>6.1f} {:>6.1f} {:>6.2f} {:>6.2f} {:>6.2f} {:>6.1f} {:>6.1f} {:>8.3f}\n",
-                         r.sequence, w, r.detector, r.corners, r.m.precision(), r.m.recall(), r.err.median, r.err.mean,
-                         r.err.p90, eval::reduction_rate(r.events, r.corners), eval::ft_percent(r.corners, r.on_track),
-                         us_per_event(r));
+        s += fmt::format("{:<{}}  {:<18} {:>9} {:>6.1f} {:>6.1f} {:>6} {:>6.2f} {:>6.2f} {:>6.2f} {:>6.1f} {:>6.2f} {:>6.1f} "
+                         "{:>8.3f}\n",
+                         r.sequence, w, r.detector, r.corners, r.m.precision(), r.m.recall(), ap_cell(r), r.err.median,
+                         r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners), r.m.smear(),
+                         eval::ft_percent(r.corners, r.on_track), us_per_event(r));
     return s;
 }
 
 std::string truth_table_csv(const std::vector<TruthRow>& rows) {
     std::string s =
         "sequence,detector,events,corners,true_positives,precision_percent,truth_samples,recalled,recall_percent,"
-        "loc_median_px,loc_mean_px,loc_p90_px,reduction_percent,ft_percent,us_per_event\n";
+        "loc_median_px,loc_mean_px,loc_p90_px,reduction_percent,ft_percent,us_per_event,average_precision,"
+        "smear_per_corner_ms\n";
     for (const auto& r : rows)
-        s += fmt::format("{},{},{},{},{},{:.4f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.6f}\n", r.sequence,
-                         r.detector, r.events, r.corners, r.m.true_positives, r.m.precision(), r.m.truth_samples,
-                         r.m.recalled, r.m.recall(), r.err.median, r.err.mean, r.err.p90,
+        s += fmt::format("{},{},{},{},{},{:.4f},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.6f},{},{:.4f}\n",
+                         r.sequence, r.detector, r.events, r.corners, r.m.true_positives, r.m.precision(),
+                         r.m.truth_samples, r.m.recalled, r.m.recall(), r.err.median, r.err.mean, r.err.p90,
                          eval::reduction_rate(r.events, r.corners), eval::ft_percent(r.corners, r.on_track),
-                         us_per_event(r));
+                         us_per_event(r), r.pr.points.empty() ? std::string() : ap_cell(r, 6), r.m.smear());
+    return s;
+}
+
+nlohmann::json pr_json(const eval::PrCurve& c) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& p : eval::thin(c.points, 200))
+        j.push_back({std::isinf(p.threshold) ? nlohmann::json(nullptr) : nlohmann::json(p.threshold), p.precision,
+                     p.recall});
+    return j;
+}
+
+// Per detector kind, the mean over the sequences of the truth table's figures.
+std::string truth_summary_text(const std::vector<TruthRow>& rows, bool markdown) {
+    std::vector<std::string> order;
+    std::map<std::string, std::vector<const TruthRow*>> by;
+    for (const auto& r : rows) {
+        if (!by.count(r.detector)) order.push_back(r.detector);
+        by[r.detector].push_back(&r);
+    }
+    std::string s = markdown ? "| detector | sequences | precision % | recall % | AP | loc. median px | Red. % | smear "
+                               "/corner/ms |\n|---|---:|---:|---:|---:|---:|---:|---:|\n"
+                             : fmt::format("{:<18} {:>5} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}\n", "detector", "seqs",
+                                           "P %", "R %", "AP", "med px", "Red.%", "smear");
+    for (const auto& d : order) {
+        const auto& v = by[d];
+        double p = 0, r = 0, ap = 0, med = 0, red = 0, sm = 0;
+        bool has_ap = true;
+        for (const TruthRow* t : v) {
+            p += t->m.precision();
+            r += t->m.recall();
+            has_ap = has_ap && !t->pr.points.empty();
+            ap += t->pr.average_precision;
+            med += t->err.median;
+            red += eval::reduction_rate(t->events, t->corners);
+            sm += t->m.smear();
+        }
+        const double n = static_cast<double>(v.size());
+        const std::string apc = has_ap ? fmt::format("{:.3f}", ap / n) : std::string("-");
+        s += markdown ? fmt::format("| {} | {} | {:.1f} | {:.1f} | {} | {:.2f} | {:.1f} | {:.2f} |\n", d, v.size(), p / n,
+                                    r / n, apc, med / n, red / n, sm / n)
+                      : fmt::format("{:<18} {:>5} {:>6.1f} {:>6.1f} {:>6} {:>6.2f} {:>6.1f} {:>6.2f}\n", d, v.size(),
+                                    p / n, r / n, apc, med / n, red / n, sm / n);
+    }
+    return s;
+}
+
+// The PR curves, each thinned to at most 200 points (AP is of the whole curve).
+std::string pr_curve_csv(const std::vector<TruthRow>& rows) {
+    std::string s = "sequence,detector,threshold,precision_percent,recall_percent\n";
+    for (const auto& r : rows)
+        for (const auto& p : eval::thin(r.pr.points, 200))
+            s += fmt::format("{},{},{:.9g},{:.4f},{:.4f}\n", r.sequence, r.detector, p.threshold, p.precision, p.recall);
     return s;
 }
 
@@ -505,7 +603,7 @@ std::vector<eval::TruthMatchResult> match_against_truth(const fs::path& truth, c
                                                         const eval::TruthMatchParams& params, bool progress,
                                                         std::vector<Event>* tracks) {
     std::vector<eval::TruthMatcher> matchers;
-    for (const DetectorRuns& k : kinds) matchers.emplace_back(k.corners, params);
+    for (const DetectorRuns& k : kinds) matchers.emplace_back(k.corners, k.scores, params);
     sim::TruthReader reader(truth.string());
     std::vector<sim::TruthCorner> rows;
     Progress bar(progress, reader.bytes_total());
@@ -532,10 +630,21 @@ void run_eval(EvalOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
     const std::vector<std::string> detectors = parse_detector_list(o.detectors);
     check_params_taken(detectors, o.detector_params, "--");
-    std::vector<DetectorConfig> configs;
+    if (o.nms && o.compare_nms) throw CLI::ValidationError("--nms and --compare-nms: give one of them");
+    std::optional<NmsParams> nms;
+    if (o.nms || o.compare_nms) {
+        o.nms_params.rule = parse_nms_rule(o.nms_rule);
+        check_nms_params(o.nms_params);
+        nms = o.nms_params;
+    }
+    std::vector<EvalKind> configs;
     for (const auto& d : detectors) {
-        configs.push_back(config_for(d, o.detector_params));
-        check_detector_config(configs.back(), "--");
+        DetectorConfig c = config_for(d, o.detector_params);
+        check_detector_config(c, "--");
+        if (nms && !detector_info(d).has_score)
+            throw std::invalid_argument("--nms: detector '" + d + "' has no score to suppress by");
+        if (!o.nms) configs.push_back({c, std::nullopt, d});
+        if (nms) configs.push_back({c, nms, d + "+nms"});
     }
     std::vector<Sequence> seqs = find_sequences(o.inputs);
     o.match.credit = eval::parse_credit(o.credit);
@@ -557,7 +666,7 @@ void run_eval(EvalOptions& o) {
         for (const Sequence& seq : seqs)
             if (!seq.truth.empty()) inputs.push_back({"--truth", seq.truth.string()});
         for (const char* name : {"table1.csv", "table2.csv", "results.json", "report.md", "truth_table.csv",
-                                 "truth_speed.csv"})
+                                 "truth_speed.csv", "pr_curve.csv"})
             outputs.push_back({"--report", (fs::path(o.report) / name).string()});
         io::check_output_paths(inputs, outputs);
         fs::create_directories(o.report);
@@ -565,19 +674,25 @@ void run_eval(EvalOptions& o) {
     }
     std::vector<eval::RunRecord> runs;
     nlohmann::json jruns = nlohmann::json::array();
-    std::string figures_md, truth_figures_md, speed_figures_md;
+    std::string figures_md, truth_figures_md, speed_figures_md, pr_figures_md;
     const bool show_progress = !o.quiet && !o.no_progress;
     std::vector<Event> batch(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
+    std::vector<double> scores(kBatch);
     for (const auto& seq : seqs) {
         InputOptions in = o.in;
         if (in.size.empty()) in.size = scene_sensor_beside(seq);
         const auto reader = open_events(seq.file.string(), in);
         const SensorSize size = sensor_of(*reader);
         std::vector<DetectorRuns> kinds;
-        for (const DetectorConfig& config : configs) {
-            DetectorRuns k{config.name, {}, std::vector<double>(static_cast<std::size_t>(o.repeat), 0.0), {}};
-            for (int rep = 0; rep < o.repeat; ++rep) k.detectors.push_back(make_detector(config, size, "--"));
+        for (const EvalKind& kind : configs) {
+            DetectorRuns k{kind.name, {}, std::vector<double>(static_cast<std::size_t>(o.repeat), 0.0), {}, {}, false, {}};
+            for (int rep = 0; rep < o.repeat; ++rep) {
+                k.detectors.push_back(make_detector(kind.config, size, "--"));
+                if (kind.nms) k.nms.push_back(std::make_unique<AsyncNms>(size, *kind.nms));
+            }
+            // Scores for NMS, and for the PR curve against a truth.
+            k.scored = has_score(k.detectors.front()) && (kind.nms || !seq.truth.empty());
             kinds.push_back(std::move(k));
         }
         std::unique_ptr<StreamFigures> figs;
@@ -592,13 +707,20 @@ void run_eval(EvalOptions& o) {
                 const std::span<const Event> events(batch.data(), n);
                 for (DetectorRuns& k : kinds) {
                     for (std::size_t rep = 0; rep < k.detectors.size(); ++rep) {
-                        // Timed: the detector's batch call only.
+                        // Timed: the detector's batch call (and NMS's) only. With NMS every run
+                        // is scored; without, only the first when a truth wants its scores.
+                        const bool scored = k.scored && (!k.nms.empty() || rep == 0);
+                        const std::span<double> sc = scored ? std::span<double>(scores.data(), n) : std::span<double>();
                         const auto t0 = Clock::now();
-                        std::visit([&](auto& d) { detect(d, events, flags); }, k.detectors[rep]);
+                        detect_batch(k.detectors[rep], k.nms.empty() ? nullptr : k.nms[rep].get(), events,
+                                     std::span<std::uint8_t>(flags.data(), n), sc);
                         k.seconds[rep] += std::chrono::duration<double>(Clock::now() - t0).count();
                         if (rep == 0)
                             for (std::size_t i = 0; i < n; ++i)
-                                if (flags[i]) k.corners.push_back(events[i]);
+                                if (flags[i]) {
+                                    k.corners.push_back(events[i]);
+                                    if (scored) k.scores.push_back(scores[i]);
+                                }
                     }
                 }
                 if (figs) figs->add(events);
@@ -614,8 +736,15 @@ void run_eval(EvalOptions& o) {
         }
         if (!o.quiet) fmt::print(stderr, "eval: {}: {} events; labelling\n", seq.name, n_events);
         std::vector<ChartSeriesPair> speed_series;
+        std::vector<render::ChartSeries> pr_series;
+        const std::vector<double> recall_levels = [] {
+            std::vector<double> v;
+            for (int r = 0; r <= 100; r += 5) v.push_back(r);
+            return v;
+        }();
         for (DetectorRuns& k : kinds) {
             k.detectors.clear();  // their state is no longer needed
+            k.nms.clear();
             std::vector<Event>& corners = k.corners;
             const auto l0 = Clock::now();
             eval::FeatureTrackResult labels;
@@ -632,6 +761,13 @@ void run_eval(EvalOptions& o) {
                 TruthRow tr{seq.name, k.name, n_events, corners.size(), labels.labelled, r.detect_s,
                             std::move(matched[static_cast<std::size_t>(&k - kinds.data())]), {}};
                 tr.err = eval::summarize_errors(tr.m.errors);
+                if (k.scored) {
+                    tr.pr = eval::pr_curve(k.scores, tr.m.is_true, tr.m.recalled_best, tr.m.truth_samples);
+                    pr_series.push_back({k.name, render::series_colour(pr_series.size()),
+                                         eval::precision_at_recall(tr.pr.points, recall_levels)});
+                }
+                tr.m.recalled_best = {};
+                std::vector<double>().swap(k.scores);
                 nlohmann::json jbins = nlohmann::json::array();
                 ChartSeriesPair sp{k.name, {}, {}};
                 for (const auto& b : tr.m.bins) {
@@ -654,6 +790,10 @@ void run_eval(EvalOptions& o) {
                           {"loc_median_px", tr.err.median},
                           {"loc_mean_px", tr.err.mean},
                           {"loc_p90_px", tr.err.p90},
+                          {"smear_per_corner_ms", tr.m.smear()},
+                          {"average_precision",
+                           tr.pr.points.empty() ? nlohmann::json(nullptr) : nlohmann::json(tr.pr.average_precision)},
+                          {"pr_curve", pr_json(tr.pr)},
                           {"speed_bins", jbins}};
                 if (figs && !figs->empty()) {
                     const std::string stem = seq.stem + "." + k.name;
@@ -700,6 +840,14 @@ void run_eval(EvalOptions& o) {
             }
             if (&k != &kinds.front()) std::vector<Event>().swap(corners);  // the first detector's draw Fig. 1b
         }
+        if (!pr_series.empty() && !fig_dir.empty()) {
+            std::vector<std::string> cats;
+            for (const double r : recall_levels) cats.push_back(fmt::format("{:g}", r));
+            render::write_png((fig_dir / (seq.stem + ".pr.png")).string(),
+                              render::render_line_chart(seq.name + ": precision (interpolated) against recall (%)",
+                                                        cats, pr_series, 100, "%"));
+            pr_figures_md += fmt::format("| {} | ![](figures/{}.pr.png) |\n", seq.name, seq.stem);
+        }
         if (!speed_series.empty() && !fig_dir.empty()) {
             std::vector<std::string> cats;
             for (const auto& b : truth_rows.back().m.bins) cats.push_back(speed_bin_label(b));
@@ -739,8 +887,12 @@ void run_eval(EvalOptions& o) {
         "an event near several corners credits {} (docs/evaluation.md)",
         o.match.radius, eval::to_string(o.match.interpolation), o.match.tolerance_us,
         o.match.credit == eval::Credit::all ? "all of them" : "the nearest");
-    if (!truth_rows.empty())
+    if (!truth_rows.empty()) {
         fmt::print("\nAgainst ground truth: {}\n{}", match_rule, truth_table_text(truth_rows, false));
+        fmt::print("\nMean over the sequences (AP: average precision of the score's PR curve, docs/evaluation.md; "
+                   "smear: true corner events per visible truth corner per ms)\n{}",
+                   truth_summary_text(truth_rows, false));
+    }
     if (o.report.empty()) return;
     const fs::path dir(o.report);
     write_file(dir / "table1.csv", table1_csv(runs));
@@ -767,12 +919,19 @@ void run_eval(EvalOptions& o) {
     if (!truth_rows.empty()) {
         write_file(dir / "truth_table.csv", truth_table_csv(truth_rows));
         write_file(dir / "truth_speed.csv", truth_speed_csv(truth_rows));
+        write_file(dir / "pr_curve.csv", pr_curve_csv(truth_rows));
         nlohmann::json edges = o.match.speed_edges;
         j["truth_match"] = {{"radius_px", o.match.radius},
                             {"tolerance_us", o.match.tolerance_us},
                             {"credit", std::string(eval::to_string(o.match.credit))},
                             {"interpolation", std::string(eval::to_string(o.match.interpolation))},
                             {"speed_edges", edges}};
+    }
+    if (nms) {
+        j["nms"] = {{"rule", nms_rule_name(nms->rule)},
+                    {"radius", nms->radius},
+                    {"time_us", nms->time_us},
+                    {"compare", o.compare_nms}};
     }
     write_file(dir / "results.json", j.dump(2) + "\n");
     std::string md = "# evcorner evaluation\n\n";
@@ -785,6 +944,11 @@ void run_eval(EvalOptions& o) {
         o.params.inner_radius, o.params.outer_radius, o.params.min_inner, o.params.max_outer_ratio,
         o.params.max_duration_us, o.params.max_length, o.params.same_polarity ? "per polarity" : "both polarities",
         eval::to_string(o.params.overlap), o.repeat, kBatch, o.repeat);
+    if (nms)
+        md += fmt::format("Non-maximum suppression (docs/nms.md): rule {}, radius {} px, {} {} us, after the detectors "
+                          "named NAME+nms{}.\n\n",
+                          nms_rule_name(nms->rule), nms->radius, nms->rule == NmsRule::window ? "window" : "decay",
+                          nms->time_us, o.compare_nms ? " (beside each detector without it)" : "");
     md += "## Table 1: reduction rate and FT (%)\n\n" + table1_text(t1, true) + "\n";
     std::map<std::string, std::string> base;
     for (const auto& q : seqs) base[q.name] = q.base;
@@ -799,7 +963,15 @@ void run_eval(EvalOptions& o) {
         md += "## Against ground truth (simulated scenes)\n\nMatching: " + match_rule +
               ". Precision and FT side by side: FT counts corner events on feature tracks found in the detector's "
               "own output, precision those within the radius of a true corner.\n\n" +
-              truth_table_text(truth_rows, true) + "\n";
+              truth_table_text(truth_rows, true) + "\n### Mean over the sequences\n\n" +
+              truth_summary_text(truth_rows, true) +
+              "\nAP: the average precision of the detector's score threshold swept over its corner events "
+              "(precision-recall curve; pr_curve.csv); smear: true corner events per visible truth corner per "
+              "millisecond (docs/evaluation.md).\n\n";
+        if (!pr_figures_md.empty())
+            md += "### Precision-recall curves\n\nThe score threshold swept from the largest score down; precision "
+                  "interpolated (the largest at a recall at least the level), absent beyond the detector's full "
+                  "recall.\n\n| sequence | precision against recall |\n|---|---|\n" + pr_figures_md + "\n";
         if (!speed_figures_md.empty())
             md += "### Precision and recall against image speed\n\nAn event counts in the speed bin of the nearest "
                   "visible corner at its time, a truth sample in its own (truth_speed.csv has the counts).\n\n"
@@ -887,6 +1059,10 @@ void add_eval_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::IsMember({"linear", "nearest"}))
         ->group(tg);
+    add_nms_options(*cmd, o->nms, o->nms_params, o->nms_rule);
+    cmd->add_flag("--compare-nms", o->compare_nms,
+                  "Run every detector twice: without NMS and with it (as NAME+nms), with the --nms-* options")
+        ->group("Non-maximum suppression");
     cmd->add_option("--speed-bins", o->speed_edges,
                     "Image-speed bin edges, px/s, from 0, increasing [default: 0,50,100,200,400,700]")
         ->delimiter(',')
@@ -897,7 +1073,8 @@ void add_eval_command(CLI::App& app) {
         "  evcorner eval a/events.txt b.txt -d efast,harris --repeat 3\n"
         "  evcorner eval ../shared/data/real/ecd-stppp -d all --harris-window 7 --no-figures\n"
         "  evcorner eval scene.npy --truth scene.truth.csv --report r     (simulate -o scene.npy --truth ...)\n"
-        "  evcorner eval suite/ --report r                                (simulate --suite suite/)");
+        "  evcorner eval suite/ --report r                                (simulate --suite suite/)\n"
+        "  evcorner eval suite/ --compare-nms --nms-rule window --report r (each detector with and without NMS)");
     cmd->callback([o] { run_eval(*o); });
 }
 

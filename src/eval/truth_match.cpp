@@ -39,6 +39,10 @@ double TruthMatchResult::recall() const noexcept {
     return truth_samples == 0 ? 0.0 : 100.0 * static_cast<double>(recalled) / static_cast<double>(truth_samples);
 }
 
+double TruthMatchResult::smear() const noexcept {
+    return visible_corner_us <= 0 ? 0.0 : static_cast<double>(true_positives) / (visible_corner_us / 1000.0);
+}
+
 ErrorSummary summarize_errors(std::span<const float> errors) {
     ErrorSummary s;
     if (errors.empty()) return s;
@@ -56,8 +60,14 @@ ErrorSummary summarize_errors(std::span<const float> errors) {
 }
 
 TruthMatcher::TruthMatcher(std::span<const Event> corners, TruthMatchParams params)
-    : corners_(corners), p_(std::move(params)) {
+    : TruthMatcher(corners, {}, std::move(params)) {}
+
+TruthMatcher::TruthMatcher(std::span<const Event> corners, std::span<const double> scores, TruthMatchParams params)
+    : corners_(corners), scores_(scores), p_(std::move(params)) {
     validate(p_);
+    if (!scores_.empty() && scores_.size() != corners_.size())
+        throw std::invalid_argument("TruthMatcher: " + std::to_string(scores_.size()) + " scores for " +
+                                    std::to_string(corners_.size()) + " corner events");
     r_.is_true.assign(corners_.size(), 0);
     for (std::size_t k = 0; k < p_.speed_edges.size(); ++k)
         r_.bins.push_back({p_.speed_edges[k],
@@ -141,6 +151,10 @@ void TruthMatcher::match_events_until(std::int64_t t_end, bool to_end) {
         r_.is_true[next_event_] = 1;
         r_.errors.push_back(static_cast<float>(std::sqrt(best)));
         for (const std::uint32_t id : credited) {
+            if (!scores_.empty()) {
+                const double sc = scores_[next_event_];
+                tracks_[id].hits.push_back({e.t, std::isnan(sc) ? -std::numeric_limits<double>::infinity() : sc});
+            }
             auto& open = tracks_[id].open;
             const std::int64_t lo = e.t - tol, hi = e.t + tol;
             if (open.size() > tracks_[id].first && lo <= open.back().second + 1)
@@ -167,6 +181,7 @@ void TruthMatcher::decide_samples_until(std::int64_t t_end, bool to_end) {
         if (found) {
             ++b.recalled;
             ++r_.recalled;
+            if (!scores_.empty()) r_.recalled_best.push_back(best_for(tr, s.t));
         }
     }
     if (pending_first_ > 4096 && pending_first_ * 2 > pending_.size()) {
@@ -175,12 +190,40 @@ void TruthMatcher::decide_samples_until(std::int64_t t_end, bool to_end) {
     }
 }
 
+// The largest score of the track's credited events within tolerance of sample time s (the
+// samples of a track come in time order: a sliding-window maximum).
+double TruthMatcher::best_for(Track& tr, std::int64_t s) {
+    const std::int64_t lo = s - p_.tolerance_us, hi = s + p_.tolerance_us;
+    auto& w = tr.window;
+    for (; tr.pushed < tr.hits.size() && tr.hits[tr.pushed].first <= hi; ++tr.pushed) {
+        const auto h = tr.hits[tr.pushed];
+        while (w.size() > tr.window_first && w.back().second <= h.second) w.pop_back();
+        w.push_back(h);
+    }
+    while (tr.window_first < w.size() && w[tr.window_first].first < lo) ++tr.window_first;
+    if (tr.window_first > 64 && tr.window_first * 2 > w.size()) {
+        w.erase(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(tr.window_first));
+        tr.window_first = 0;
+    }
+    if (tr.pushed > 64 && tr.pushed * 2 > tr.hits.size()) {
+        tr.hits.erase(tr.hits.begin(), tr.hits.begin() + static_cast<std::ptrdiff_t>(tr.pushed));
+        tr.pushed = 0;
+    }
+    // A recalled sample has a credited event within tolerance: the window is not empty.
+    return tr.window_first < w.size() ? w[tr.window_first].second : -std::numeric_limits<double>::infinity();
+}
+
 void TruthMatcher::add_sample(std::span<const sim::TruthCorner> rows) {
     if (rows.empty()) return;
     const std::int64_t t = rows.front().t_us;
     for (const auto& r : rows)
         if (r.t_us != t) throw std::invalid_argument("add_sample: rows of several times");
     if (any_sample_ && t <= cur_.front().t_us) throw std::invalid_argument("add_sample: times must increase");
+    if (any_sample_) {
+        std::size_t visible = 0;
+        for (const auto& c : cur_) visible += c.state == sim::CornerState::visible;
+        r_.visible_corner_us += static_cast<double>(visible) * static_cast<double>(t - cur_.front().t_us);
+    }
     prev_.swap(cur_);
     prev_track_.swap(cur_track_);
     cur_.assign(rows.begin(), rows.end());
@@ -210,7 +253,12 @@ TruthMatchResult TruthMatcher::finish() {
 
 TruthMatchResult match_truth(std::span<const Event> corners, std::span<const sim::TruthCorner> truth,
                              const TruthMatchParams& params) {
-    TruthMatcher m(corners, params);
+    return match_truth(corners, {}, truth, params);
+}
+
+TruthMatchResult match_truth(std::span<const Event> corners, std::span<const double> scores,
+                             std::span<const sim::TruthCorner> truth, const TruthMatchParams& params) {
+    TruthMatcher m(corners, scores, params);
     std::size_t i = 0;
     while (i < truth.size()) {
         std::size_t j = i;

@@ -17,6 +17,12 @@
 //   one event, several corners   it counts once for precision (error: the nearest); for
 //                    recall it credits every corner it matches (Credit::all) or only the
 //                    nearest (Credit::nearest)
+//   with scores      (one per corner event) each recalled truth sample also gets the largest
+//                    score among the events that recall it (recalled_best): what a score
+//                    threshold needs for recall (pr_curve.hpp)
+//   smear            true positives per visible corner per millisecond: the corner time is
+//                    the sum over consecutive samples of (visible corners at the earlier) x
+//                    (time between them)
 //
 // Streaming: the corner events (time order) are given whole, the truth one sample time at a
 // time (add_sample, in time order); memory is the events, two samples and, per corner, the
@@ -72,9 +78,15 @@ struct TruthMatchResult {
     std::vector<std::uint8_t> is_true;  ///< per corner event: 1 when it matches a corner
     std::vector<float> errors;          ///< per true positive, in event order: px
     std::vector<SpeedBin> bins;
+    /// Per recalled truth sample (in the order decided), the largest score among the corner
+    /// events that recall it (NaN read as -infinity); empty when no scores were given.
+    std::vector<double> recalled_best;
+    double visible_corner_us = 0;  ///< corner time: visible corners x time, us (see smear)
 
     [[nodiscard]] double precision() const noexcept;  ///< %; 0 without corner events
     [[nodiscard]] double recall() const noexcept;     ///< %; 0 without truth samples
+    /// True positives per visible truth corner per millisecond; 0 without corner time.
+    [[nodiscard]] double smear() const noexcept;
 };
 
 struct ErrorSummary {
@@ -87,6 +99,9 @@ class TruthMatcher {
 public:
     /// `corners` in time order (a detector's output); kept by reference until finish().
     TruthMatcher(std::span<const Event> corners, TruthMatchParams params);
+    /// With a score per corner event (kept by reference too): the result's recalled_best is
+    /// filled. Throws std::invalid_argument when the lengths differ.
+    TruthMatcher(std::span<const Event> corners, std::span<const double> scores, TruthMatchParams params);
 
     /// The truth rows of one sample time, later than the last one's. Throws
     /// std::invalid_argument for a time not later, or rows of several times.
@@ -100,6 +115,12 @@ private:
         // The open recall intervals [lo, hi] of this corner's matches, merged, by time.
         std::vector<std::pair<std::int64_t, std::int64_t>> open;
         std::size_t first = 0;  // open[first..] are live
+        // With scores: the credited events (time, score) in time order, hits[pushed..] not yet
+        // in `window`, a deque of decreasing scores of those in the current sample's window.
+        std::vector<std::pair<std::int64_t, double>> hits;
+        std::size_t pushed = 0;
+        std::vector<std::pair<std::int64_t, double>> window;
+        std::size_t window_first = 0;
     };
     struct Pending {
         std::int64_t t;
@@ -111,7 +132,9 @@ private:
     std::uint32_t track_of(const sim::TruthCorner& c);
     int bin_of(double speed) const noexcept;
 
+    double best_for(Track& tr, std::int64_t s);
     std::span<const Event> corners_;
+    std::span<const double> scores_;
     TruthMatchParams p_;
     std::size_t next_event_ = 0;
     std::vector<sim::TruthCorner> prev_, cur_;  // the two newest samples (prev_ may be empty)
@@ -128,5 +151,8 @@ private:
 /// time order, as read_truth_csv gives them).
 TruthMatchResult match_truth(std::span<const Event> corners, std::span<const sim::TruthCorner> truth,
                              const TruthMatchParams& params);
+/// The same with a score per corner event (recalled_best filled).
+TruthMatchResult match_truth(std::span<const Event> corners, std::span<const double> scores,
+                             std::span<const sim::TruthCorner> truth, const TruthMatchParams& params);
 
 }  // namespace evcorner::eval
