@@ -85,7 +85,7 @@ std::uint32_t TruthMatcher::track_of(const sim::TruthCorner& c) {
     const auto it = std::lower_bound(track_index_.begin(), track_index_.end(), std::make_pair(key, std::uint32_t{0}));
     if (it != track_index_.end() && it->first == key) return it->second;
     const auto id = static_cast<std::uint32_t>(tracks_.size());
-    tracks_.push_back({key, {}, 0});
+    tracks_.emplace_back().key = key;
     track_index_.insert(it, {key, id});
     return id;
 }

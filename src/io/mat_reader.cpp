@@ -144,6 +144,18 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
                                         : "several N x 4 numeric variables: " + list + "; pick one with --mat-var");
         }
     }
+    // A damaged header can declare far more data than the file holds (fuzz_mat: 2^31 rows in
+    // a 360-byte file), and libmatio would allocate it all before reading. Deflate (v5
+    // compressed, v7.3) expands at most 1032:1, so a declared size beyond that is damage.
+    if (VarPtr info{Mat_VarReadInfo(mat.get(), var_.c_str())}) {
+        double declared = static_cast<double>(Mat_SizeOfClass(info->class_type));
+        for (int d = 0; d < info->rank && info->dims; ++d) declared *= static_cast<double>(info->dims[d]);
+        const double limit = 1032.0 * static_cast<double>(file_size_.value_or(0)) + 65536.0;
+        if (declared > limit)
+            throw InputError(name_, fmt::format("variable {} declares {:.0f} bytes of data, more than this {}-byte "
+                                                "file can hold even compressed: the file is damaged",
+                                                describe(info.get()), declared, file_size_.value_or(0)));
+    }
     VarPtr var(Mat_VarRead(mat.get(), var_.c_str()));
     if (!var)
         throw InputError(name_, "no variable " + quote_bytes(var_) + " can be read" +
