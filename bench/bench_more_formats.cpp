@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "npy_bytes.hpp"
 #include "read_throughput.hpp"
 
 namespace {
@@ -52,14 +53,7 @@ void put(std::string& s, T v) {
     std::memcpy(b, &v, sizeof(T));
     s.append(b, sizeof(T));
 }
-std::string npy(std::string dict, const std::string& data) {
-    while ((10 + dict.size() + 1) % 64 != 0) dict += ' ';
-    dict += '\n';
-    std::string f("\x93NUMPY\x01\x00", 8);
-    f += static_cast<char>(dict.size() & 0xFF);
-    f += static_cast<char>(dict.size() >> 8);
-    return f + dict + data;
-}
+using evcorner::test::npy_file;
 
 // Event i of the synthetic stream: 240x180, time rising 1 us every 3 events.
 inline std::int64_t ti(std::size_t i) { return static_cast<std::int64_t>(i / 3); }
@@ -92,11 +86,11 @@ void make_files() {
         for (double v : {static_cast<double>(ti(i)) * 1e-6, double(xi(i)), double(yi(i)), double(pi(i))}) put<double>(n4, v);
     }
     save("a.bin", atis);
-    save("fast.npy", npy(fmt::format("{{'descr': [('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|u1'), ('_', '|V3')], "
+    save("fast.npy", npy_file(fmt::format("{{'descr': [('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|u1'), ('_', '|V3')], "
                                      "'fortran_order': False, 'shape': ({},), }}", kEvents), fast));
-    save("fields.npy", npy(fmt::format("{{'descr': [('x', '<u4'), ('y', '<u4'), ('p', '|i1'), ('ts', '<i8')], "
+    save("fields.npy", npy_file(fmt::format("{{'descr': [('x', '<u4'), ('y', '<u4'), ('p', '|i1'), ('ts', '<i8')], "
                                        "'fortran_order': False, 'shape': ({},), }}", kEvents), fields));
-    save("n4.npy", npy(fmt::format("{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, 4), }}", kEvents), n4));
+    save("n4.npy", npy_file(fmt::format("{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, 4), }}", kEvents), n4));
     {
         std::vector<double> m(kEvents * 4);
         for (std::size_t i = 0; i < kEvents; ++i) {

@@ -15,6 +15,7 @@
 #include "evcorner/error.hpp"
 #include "evcorner/event.hpp"
 #include "evcorner/io/event_reader.hpp"
+#include "npy_bytes.hpp"
 
 namespace evcorner::test {
 
@@ -120,18 +121,6 @@ inline void put_le32(std::string& s, std::uint32_t v) {
 inline void put_le16(std::string& s, std::uint16_t v) {
     s.push_back(static_cast<char>(v & 0xFF));
     s.push_back(static_cast<char>(v >> 8));
-}
-
-/// A .npy file (format 1.0): the header dict `dict_body` padded so that the data starts
-/// on a 64-byte boundary, then `data`.
-inline std::string npy_file(const std::string& dict_body, const std::string& data) {
-    std::string dict = dict_body;
-    while ((10 + dict.size() + 1) % 64 != 0) dict += ' ';
-    dict += '\n';
-    std::string f("\x93NUMPY\x01\x00", 8);
-    f += static_cast<char>(dict.size() & 0xFF);
-    f += static_cast<char>(dict.size() >> 8);
-    return f + dict + data;
 }
 
 }  // namespace evcorner::test
