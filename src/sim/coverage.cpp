@@ -2,17 +2,25 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace evcorner::sim {
 
 namespace {
 
+inline void set_bit(std::uint64_t* row_bits, int k) noexcept {
+    row_bits[static_cast<unsigned>(k) >> 6] |= std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
+}
+
 // One edge from (x0, y0) to (x1, y1), y0 < y1; h for a row is sign * its y-extent there.
 // Dual: the same edge also into acc2 with sign2, every value computed as a pass of its own
 // would (the same operations in the same order), so that one walk serves both.
+// Record: also sets, in `bits` (words_per_row 64-bit words per row), the bit of every column
+// whose acc entry it changes.
+
 template <bool Record, bool Dual = false>
 void accumulate_edge(double x0, double y0, double x1, double y1, double sign, double* acc, std::size_t stride, int width,
-                     int height, std::vector<std::vector<int>>* touched, double sign2 = 0,
+                     int height, std::uint64_t* bits, std::size_t words_per_row, double sign2 = 0,
                      double* acc2 = nullptr) noexcept {
     const double dxdy = (x1 - x0) / (y1 - y0);
     const int r0 = std::max(0, static_cast<int>(std::floor(y0)));
@@ -25,13 +33,13 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
         double* row = acc + static_cast<std::size_t>(r) * stride;
         [[maybe_unused]] const double h2 = Dual ? sign2 * (yb - ya) : 0.0;
         [[maybe_unused]] double* row2 = Dual ? acc2 + static_cast<std::size_t>(r) * stride : nullptr;
-        [[maybe_unused]] std::vector<int>* cols = Record ? &(*touched)[static_cast<std::size_t>(r)] : nullptr;
+        [[maybe_unused]] std::uint64_t* cols = Record ? bits + static_cast<std::size_t>(r) * words_per_row : nullptr;
         const double xa = x0 + (ya - y0) * dxdy, xb = x0 + (yb - y0) * dxdy;
         const double xl = std::min(xa, xb), xr = std::max(xa, xb);
         if (xr <= 0) {  // wholly left of the sensor: covers every pixel of the row to its right
             row[0] += h;
             if constexpr (Dual) row2[0] += h2;
-            if constexpr (Record) cols->push_back(0);
+            if constexpr (Record) set_bit(cols, 0);
             continue;
         }
         if (xl >= width) continue;
@@ -44,8 +52,8 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
                 row2[k + 1] += h2 * (xl - k);
             }
             if constexpr (Record) {
-                cols->push_back(k);
-                cols->push_back(k + 1);
+                set_bit(cols, k);
+                set_bit(cols, k + 1);
             }
             continue;
         }
@@ -55,7 +63,7 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
         if (lo < 0) {
             row[0] += per_x * (0 - lo);
             if constexpr (Dual) row2[0] += per_x2 * (0 - lo);
-            if constexpr (Record) cols->push_back(0);
+            if constexpr (Record) set_bit(cols, 0);
             lo = 0;
         }
         const double hi_end = std::min(xr, static_cast<double>(width));
@@ -72,8 +80,8 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
                 row2[k + 1] += hp2 * (xm - k);
             }
             if constexpr (Record) {
-                cols->push_back(k);
-                cols->push_back(k + 1);
+                set_bit(cols, k);
+                set_bit(cols, k + 1);
             }
             lo = hi;
             ++k;
@@ -81,18 +89,20 @@ void accumulate_edge(double x0, double y0, double x1, double y1, double sign, do
     }
 }
 
-template <bool Record>
-void accumulate(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width, int height,
-                std::vector<std::vector<int>>* touched) noexcept {
+template <bool Record, bool Dual>
+void accumulate(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2, std::size_t stride,
+                int width, int height, std::uint64_t* bits, std::size_t words_per_row) noexcept {
     const std::size_t n = poly.size();
     for (std::size_t i = 0; i < n; ++i) {
         const Vec2 a = poly[i], b = poly[(i + 1) % n];
         if (a.y == b.y) continue;  // horizontal edges bound no area to their right
         // Upward edges (b.y < a.y) add, downward ones subtract: a positive-area polygon covers +1.
         if (a.y < b.y)
-            accumulate_edge<Record>(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height, touched);
+            accumulate_edge<Record, Dual>(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height, bits, words_per_row,
+                                          -weight2, acc2);
         else
-            accumulate_edge<Record>(b.x, b.y, a.x, a.y, weight, acc, stride, width, height, touched);
+            accumulate_edge<Record, Dual>(b.x, b.y, a.x, a.y, weight, acc, stride, width, height, bits, words_per_row,
+                                          weight2, acc2);
     }
 }
 
@@ -100,25 +110,23 @@ void accumulate(std::span<const Vec2> poly, double weight, double* acc, std::siz
 
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
                         int height) noexcept {
-    accumulate<false>(poly, weight, acc, stride, width, height, nullptr);
+    accumulate<false, false>(poly, weight, acc, 0.0, nullptr, stride, width, height, nullptr, 0);
 }
 
 void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
                          std::size_t stride, int width, int height) noexcept {
-    const std::size_t n = poly.size();
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec2 a = poly[i], b = poly[(i + 1) % n];
-        if (a.y == b.y) continue;
-        if (a.y < b.y)
-            accumulate_edge<false, true>(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height, nullptr, -weight2, acc2);
-        else
-            accumulate_edge<false, true>(b.x, b.y, a.x, a.y, weight, acc, stride, width, height, nullptr, weight2, acc2);
-    }
+    accumulate<false, true>(poly, weight, acc, weight2, acc2, stride, width, height, nullptr, 0);
 }
 
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
-                        int height, std::vector<std::vector<int>>& touched) {
-    accumulate<true>(poly, weight, acc, stride, width, height, &touched);
+                        int height, std::uint64_t* written, std::size_t words_per_row) noexcept {
+    accumulate<true, false>(poly, weight, acc, 0.0, nullptr, stride, width, height, written, words_per_row);
+}
+
+void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
+                         std::size_t stride, int width, int height, std::uint64_t* written,
+                         std::size_t words_per_row) noexcept {
+    accumulate<true, true>(poly, weight, acc, weight2, acc2, stride, width, height, written, words_per_row);
 }
 
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size) {

@@ -10,6 +10,8 @@
 // (x is linear in y along a piece, so its mean is the midpoint). Work: one cell per piece,
 // plus one addition per pixel of the rows and columns a polygon spans.
 
+#include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -30,10 +32,15 @@ void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, 
 void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
                          std::size_t stride, int width, int height) noexcept;
 
-/// The same, also appending to touched[r] every column k of row r whose acc entry it changes
-/// (the running sum of a row changes only at those columns).
+/// The same two, also setting in `written` (a bitmap of `words_per_row` 64-bit words per row,
+/// bit x of row r = bit x % 64 of word r * words_per_row + x / 64; it must hold width + 1 bits
+/// per row) the bit of every column whose acc entry they change: the running sum of a row
+/// changes only at those columns, so a caller can add just them.
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
-                        int height, std::vector<std::vector<int>>& touched);
+                        int height, std::uint64_t* written, std::size_t words_per_row) noexcept;
+void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
+                         std::size_t stride, int width, int height, std::uint64_t* written,
+                         std::size_t words_per_row) noexcept;
 
 /// The coverage of every pixel (row-major, width x height), each in [0, 1].
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size);

@@ -69,15 +69,19 @@ private:
         [[nodiscard]] bool empty() const noexcept { return x1 < x0 || y1 < y0; }
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
-    double render(bool all_rows);     // renders into next_ over the dirty rows; returns max |dL| bound
-    void mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::vector<std::vector<std::pair<int, int>>>& spans);
+    double render(bool all_rows);     // renders into next_ over the dirty pixels; returns max |dL| bound
+    void mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::uint64_t* bits, int& y0, int& y1);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
     void emit_noise(double t1, std::vector<Event>& step_events);
+    [[nodiscard]] std::uint64_t* row_bits(std::vector<std::uint64_t>& bits, int y) noexcept {
+        return bits.data() + static_cast<std::size_t>(y) * words_;
+    }
 
     Scene scene_;
     int w_, h_;
     std::size_t stride_;
+    std::size_t words_;  // 64-bit words per bitmap row: bits for columns 0 .. w_
     double t_ = 0;
     double dt_;
     double end_;
@@ -86,15 +90,20 @@ private:
     std::vector<float> con_, coff_;
     std::vector<std::int64_t> last_;
     std::vector<double> acc_cov_, acc_int_;
-    // Per object: its pieces' polygons at the time being rendered, and the pixel rectangles
-    // it covers then (rects_) and at time_us() (prev_rects_).
+    // Per object: its pieces' polygons at the time being rendered (polys_) and at time_us()
+    // (prev_polys_), and the pixel rectangle it covers at the time being rendered.
     std::vector<std::vector<std::vector<Vec2>>> polys_, prev_polys_;
-    std::vector<Rect> rects_, prev_rects_;
+    std::vector<Rect> rects_;
     std::vector<char> moving_;
-    std::vector<std::vector<std::pair<int, int>>> spans_;  // each row's dirty columns, inclusive, sorted, disjoint
-    // The pixels near the moving edges at the time being rendered and at time_us() (the
-    // previous accepted step's cur_marks_): their union is spans_.
-    std::vector<std::vector<std::pair<int, int>>> cur_marks_, prev_marks_;
+    // Bitmaps, one row of words_ words per sensor row. The pixels the moving edges touch at
+    // the time being rendered (cur_marks_) and at time_us() (prev_marks_, kept from the step
+    // that reached it), each with the range of rows [y0, y1] outside which it is all zero;
+    // dirty_ is their union (valid over dirty_y0_ .. dirty_y1_), the pixels recomputed.
+    // written_: the columns of acc_cov_ / acc_int_ the edge accumulation wrote (all zero
+    // between renders).
+    std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, written_, zero_row_;
+    int cur_y0_ = 0, cur_y1_ = -1, prev_y0_ = 0, prev_y1_ = -1, dirty_y0_ = 0, dirty_y1_ = -1;
+    std::vector<std::uint32_t> changed_;  // the dirty pixels whose next_ differs from cur_
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
     double noise_rate_per_us_ = 0;
