@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <set>
 
-#include "evcorner/sim/coverage.hpp"
+#include "evcorner/sim/coverage_walk.hpp"
 #include "evcorner/sim/motion.hpp"
 #include "evcorner/sim/texture.hpp"
 
@@ -82,12 +82,15 @@ Simulator::Simulator(Scene scene)
         const Motion& m = scene_.objects[o].motion;
         moving_[o] = m.velocity.x != 0 || m.velocity.y != 0 || m.rotation_deg_s != 0 || m.scaling_per_s != 0;
     }
-    render(true);
-    cur_ = next_;
+    // Every object's edge walk at t = 0 (a still object's is kept for the whole run), the
+    // moving ones' edges marked as the pixels near them at time_us().
+    terms_.resize(scene_.objects.size());
     prev_y0_ = h_;
     prev_y1_ = -1;
     for (std::size_t o = 0; o < scene_.objects.size(); ++o)
-        if (moving_[o]) mark_edges(polys_[o], prev_marks_.data(), prev_y0_, prev_y1_);
+        walk_object(o, moving_[o] ? prev_marks_.data() : nullptr, prev_y0_, prev_y1_);
+    render(true);
+    cur_ = next_;
 
     const CameraParams& cam = scene_.camera;
     lref_.resize(n);
@@ -158,41 +161,73 @@ void Simulator::place_objects(double t_us) {
 }
 
 
-void Simulator::mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::uint64_t* bits, int& y0, int& y1) {
-    // Every pixel an edge touches (its closed square meets the edge, widened by kMarkMargin),
-    // in rows [y0, y1], which grow to hold the rows marked. Edges move less than kMaxMove
-    // (< 1 px) per step (step()), so a pixel whose coverage differs between the two ends of
-    // a step is touched by an edge at one end: a pixel wholly outside an object at one end
-    // and wholly inside at the other would need its boundary to sweep over the whole pixel.
-    constexpr double m = kMarkMargin;
-    for (const auto& poly : pieces) {
-        const std::size_t n = poly.size();
-        for (std::size_t i = 0; i < n; ++i) {
-            Vec2 a = poly[i], b = poly[(i + 1) % n];
-            if (a.y > b.y) std::swap(a, b);
-            if (b.y + m < 0 || a.y - m >= h_) continue;
-            const int r0 = std::max(0, static_cast<int>(std::floor(a.y - m)));
-            const int r1 = std::min(h_ - 1, static_cast<int>(std::floor(b.y + m)));
-            const bool slanted = b.y > a.y;
-            const double dxdy = slanted ? (b.x - a.x) / (b.y - a.y) : 0.0;
-            for (int r = r0; r <= r1; ++r) {
-                double xa = a.x, xb = b.x;
-                if (slanted) {
-                    const double ya = std::clamp(static_cast<double>(r) - m, a.y, b.y);
-                    const double yb = std::clamp(static_cast<double>(r + 1) + m, a.y, b.y);
-                    xa = a.x + (ya - a.y) * dxdy;
-                    xb = a.x + (yb - a.y) * dxdy;
-                }
-                const double lo_x = std::min(xa, xb) - m, hi_x = std::max(xa, xb) + m;
-                if (hi_x < 0 || lo_x >= w_) continue;
-                const int lo = static_cast<int>(std::floor(std::max(lo_x, 0.0)));
-                const int hi = std::min(w_ - 1, static_cast<int>(std::floor(hi_x)));
-                set_range(bits + static_cast<std::size_t>(r) * words_, lo, hi);
-                y0 = std::min(y0, r);
-                y1 = std::max(y1, r);
-            }
-        }
+// Collects an object's edge walk as Terms and, when `marks` is set, marks every pixel an
+// edge touches (its square meets the edge, widened by kMarkMargin) in rows [y0, y1], which
+// grow to hold the rows marked. Edges move less than kMaxMove (< 1 px) per step (step()), so
+// a pixel whose coverage differs between the two ends of a step is touched by an edge at one
+// end: a pixel wholly outside an object at one end and wholly inside at the other would need
+// its boundary to sweep over the whole pixel.
+struct Simulator::TermSink {
+    TermList& list;
+    Term* out;  // next free term of list.buf
+    Term* cap;  // end of list.buf
+    std::uint64_t* marks;
+    int& y0;
+    int& y1;
+    std::size_t stride, words;
+    int w, h;
+
+    Term* grow() {
+        const std::size_t n = static_cast<std::size_t>(out - list.buf.data());
+        list.buf.resize(std::max<std::size_t>(64, 2 * list.buf.size()));
+        cap = list.buf.data() + list.buf.size();
+        return out = list.buf.data() + n;
     }
+    void add_pair(int r, int k, double v0, double v1, double w0, double w1) {
+        Term* t = out == cap ? grow() : out;
+        t->cell = static_cast<std::uint32_t>(static_cast<std::size_t>(r) * stride + static_cast<std::size_t>(k));
+        t->row = static_cast<std::uint32_t>(r);
+        t->v0 = v0;
+        t->v1 = v1;
+        t->w0 = w0;
+        t->w1 = w1;
+        out = t + 1;
+    }
+    // A single addition (column 0) as a pair adding 0 to column 1: adding 0 changes no sum.
+    void add(int r, int k, double v, double w2) { add_pair(r, k, v, 0.0, w2, 0.0); }
+    void mark(int r, double xl, double xr) noexcept {
+        const double lo_x = xl - kMarkMargin, hi_x = xr + kMarkMargin;
+        if (hi_x < 0 || lo_x >= w) return;
+        const int lo = lo_x <= 0 ? 0 : static_cast<int>(lo_x);  // truncation is floor for x >= 0
+        const int hi = hi_x >= w - 1 ? w - 1 : static_cast<int>(hi_x);
+        set_range(marks + static_cast<std::size_t>(r) * words, lo, hi);
+        if (r < y0) y0 = r;
+        if (r > y1) y1 = r;
+    }
+    // A slanted edge's pieces in row r lie in columns floor(xl) .. floor(xr).
+    void span(int r, double xl, double xr) noexcept {
+        if (marks != nullptr) mark(r, xl, xr);
+    }
+    void flat(double y, double xl, double xr) noexcept {
+        if (marks == nullptr || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
+        const int r0 = std::max(0, static_cast<int>(std::floor(y - kMarkMargin)));
+        const int r1 = std::min(h - 1, static_cast<int>(std::floor(y + kMarkMargin)));
+        for (int r = r0; r <= r1; ++r) mark(r, xl, xr);
+    }
+};
+
+void Simulator::walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1) {
+    const Object& obj = scene_.objects[o];
+    TermList& list = terms_[o];
+    TermSink sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
+    const bool multi = obj.pieces.size() > 1;
+    for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
+        if (multi)
+            walk_coverage<true>(polys_[o][k], 1.0, obj.pieces[k].intensity, w_, h_, sink);
+        else
+            walk_coverage<false>(polys_[o][k], 1.0, 0.0, w_, h_, sink);
+    }
+    list.n = static_cast<std::size_t>(sink.out - list.buf.data());
 }
 
 double Simulator::render(bool all_rows) {
@@ -207,19 +242,19 @@ double Simulator::render(bool all_rows) {
         cur_y0_ = h_;
         cur_y1_ = -1;
         for (std::size_t o = 0; o < rects_.size(); ++o)
-            if (moving_[o]) mark_edges(polys_[o], cur_marks_.data(), cur_y0_, cur_y1_);
+            if (moving_[o]) walk_object(o, cur_marks_.data(), cur_y0_, cur_y1_);
         dirty_y0_ = std::min(cur_y0_, prev_y0_);
         dirty_y1_ = std::max(cur_y1_, prev_y1_);
-        for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
-            std::uint64_t* d = row_bits(dirty_, y);
+    }
+    // The dirty pixels start from the background.
+    const std::size_t w = static_cast<std::size_t>(w_);
+    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
+        std::uint64_t* d = row_bits(dirty_, y);
+        if (!all_rows) {
             const std::uint64_t* c = row_bits(cur_marks_, y);
             const std::uint64_t* p = row_bits(prev_marks_, y);
             for (std::size_t k = 0; k < words_; ++k) d[k] = c[k] | p[k];
         }
-    }
-    const std::size_t w = static_cast<std::size_t>(w_);
-    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
-        const std::uint64_t* d = row_bits(dirty_, y);
         const std::size_t base = static_cast<std::size_t>(y) * w;
         for (std::size_t k = 0; k < words_; ++k)
             for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
@@ -243,12 +278,26 @@ double Simulator::render(bool all_rows) {
         if (!touches) continue;
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
-        for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-            if (multi)
-                accumulate_polygon2(polys_[o][k], 1.0, acc_cov_.data(), obj.pieces[k].intensity, acc_int_.data(),
-                                    stride_, w_, h_, written_.data(), words_);
-            else
-                accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_, written_.data(), words_);
+        // The object's edge walk into the accumulators (the additions in the walk's order,
+        // so each entry gets exactly the sum accumulate_polygon would give it).
+        {
+            double* ac = acc_cov_.data();
+            double* ai = acc_int_.data();
+            std::uint64_t* wr = written_.data();
+            const std::size_t bits_per_row = words_ * 64;
+            const TermList& list = terms_[o];
+            for (const Term* t = list.buf.data(); t != list.buf.data() + list.n; ++t) {
+                ac[t->cell] += t->v0;
+                ac[t->cell + 1] += t->v1;
+                if (multi) {
+                    ai[t->cell] += t->w0;
+                    ai[t->cell + 1] += t->w1;
+                }
+                const std::size_t k = t->cell - static_cast<std::size_t>(t->row) * stride_;
+                const std::size_t bit = static_cast<std::size_t>(t->row) * bits_per_row + k;
+                wr[bit >> 6] |= std::uint64_t{1} << (bit & 63u);
+                wr[(bit + 1) >> 6] |= std::uint64_t{1} << ((bit + 1) & 63u);
+            }
         }
         const double level = obj.pieces[0].intensity;
         // The accumulation writes columns r.x0 .. r.x1 + 1 (r.x0 - 1 when rounding puts a
@@ -302,7 +351,10 @@ double Simulator::render(bool all_rows) {
                 const double a = cur_[i], b = next_[i];
                 if (a == b) continue;
                 changed_.push_back(static_cast<std::uint32_t>(i));
-                worst = std::max(worst, std::abs(a - b) / (kLogEps + std::min(a, b)));
+                // Divides only where the quotient may exceed worst (the slack covers the
+                // product's rounding, so worst ends exactly the largest quotient).
+                const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
+                if (d >= worst * den * (1.0 - 1e-9)) worst = std::max(worst, d / den);
             }
     }
     return all_rows ? 0 : worst;

@@ -8,10 +8,10 @@
 // column k adds h (k + 1 - xm) to its own cell and h (xm - k) to the next one; the running
 // sum along each row then gives every pixel the area between the edges to its left, exactly
 // (x is linear in y along a piece, so its mean is the midpoint). Work: one cell per piece,
-// plus one addition per pixel of the rows and columns a polygon spans.
+// plus one addition per pixel of the rows and columns a polygon spans. The edge walk itself
+// is walk_coverage() (coverage_walk.hpp).
 
 #include <cstddef>
-#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -31,16 +31,6 @@ void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, 
 /// edges; each array gets exactly the values two separate calls would give.
 void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
                          std::size_t stride, int width, int height) noexcept;
-
-/// The same two, also setting in `written` (a bitmap of `words_per_row` 64-bit words per row,
-/// bit x of row r = bit x % 64 of word r * words_per_row + x / 64; it must hold width + 1 bits
-/// per row) the bit of every column whose acc entry they change: the running sum of a row
-/// changes only at those columns, so a caller can add just them.
-void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
-                        int height, std::uint64_t* written, std::size_t words_per_row) noexcept;
-void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
-                         std::size_t stride, int width, int height, std::uint64_t* written,
-                         std::size_t words_per_row) noexcept;
 
 /// The coverage of every pixel (row-major, width x height), each in [0, 1].
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size);

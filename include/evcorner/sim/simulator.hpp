@@ -70,7 +70,21 @@ private:
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
     double render(bool all_rows);     // renders into next_ over the dirty pixels; returns max |dL| bound
-    void mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::uint64_t* bits, int& y0, int& y1);
+    // Two additions of an object's edge walk (coverage_walk.hpp): acc_cov_[cell] += v0,
+    // acc_cov_[cell + 1] += v1 (and w0, w1 into acc_int_ for a checkerboard), in sensor row `row`.
+    struct Term {
+        std::uint32_t cell, row;
+        double v0, v1, w0, w1;
+    };
+    // An object's terms: buf holds n of them (buf's size is only the capacity).
+    struct TermList {
+        std::vector<Term> buf;
+        std::size_t n = 0;
+    };
+    struct TermSink;
+    // Walks object o's edges as placed in polys_ into terms_[o]; with marks, also marks the
+    // pixels its edges touch there (rows y0 .. y1 grow to hold them).
+    void walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
     void emit_noise(double t1, std::vector<Event>& step_events);
@@ -90,6 +104,7 @@ private:
     std::vector<float> con_, coff_;
     std::vector<std::int64_t> last_;
     std::vector<double> acc_cov_, acc_int_;
+    std::vector<TermList> terms_;  // per object, its edge walk at the time being rendered
     // Per object: its pieces' polygons at the time being rendered (polys_) and at time_us()
     // (prev_polys_), and the pixel rectangle it covers at the time being rendered.
     std::vector<std::vector<std::vector<Vec2>>> polys_, prev_polys_;
