@@ -21,8 +21,8 @@ constexpr double kSnap = 1e-12;
 constexpr double kMaxMove = 0.75;
 constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
 
-// Edges are widened by this much (px) when marking the pixels they touch, so that rounding
-// never leaves out a pixel an edge grazes (an extra pixel costs only time).
+// Horizontal edges are widened by this much (px) when marking the pixels they touch, so that
+// rounding never leaves out a pixel one grazes (an extra pixel costs only time).
 constexpr double kMarkMargin = 1e-7;
 
 // Sets bits lo .. hi (inclusive) of a bitmap row.
@@ -162,11 +162,14 @@ void Simulator::place_objects(double t_us) {
 
 
 // Collects an object's edge walk as Terms and, when `marks` is set, marks every pixel an
-// edge touches (its square meets the edge, widened by kMarkMargin) in rows [y0, y1], which
-// grow to hold the rows marked. Edges move less than kMaxMove (< 1 px) per step (step()), so
-// a pixel whose coverage differs between the two ends of a step is touched by an edge at one
-// end: a pixel wholly outside an object at one end and wholly inside at the other would need
-// its boundary to sweep over the whole pixel.
+// edge passes through in rows [y0, y1], which grow to hold the rows marked: the cell of every
+// piece of a slanted edge (the computed coverage of a pixel without one is a sum of whole
+// piece heights, 0 or 1 up to rounding that kSnap removes) and every cell a horizontal edge
+// meets (widened by kMarkMargin). Edges move less than kMaxMove (< 1 px) per step (step()),
+// so a pixel whose coverage differs between the two ends of a step is touched by an edge at
+// one end: a pixel wholly outside an object at one end and wholly inside at the other would
+// need its boundary to sweep over the whole pixel.
+template <bool Dual>
 struct Simulator::TermSink {
     TermList& list;
     Term* out;  // next free term of list.buf
@@ -183,51 +186,59 @@ struct Simulator::TermSink {
         cap = list.buf.data() + list.buf.size();
         return out = list.buf.data() + n;
     }
-    void add_pair(int r, int k, double v0, double v1, double w0, double w1) {
+    void push(int r, int k, double v0, double v1, double w0, double w1) {
         Term* t = out == cap ? grow() : out;
         t->cell = static_cast<std::uint32_t>(static_cast<std::size_t>(r) * stride + static_cast<std::size_t>(k));
         t->row = static_cast<std::uint32_t>(r);
         t->v0 = v0;
         t->v1 = v1;
-        t->w0 = w0;
-        t->w1 = w1;
+        if constexpr (Dual) {
+            t->w0 = w0;
+            t->w1 = w1;
+        }
         out = t + 1;
     }
-    // A single addition (column 0) as a pair adding 0 to column 1: adding 0 changes no sum.
-    void add(int r, int k, double v, double w2) { add_pair(r, k, v, 0.0, w2, 0.0); }
-    void mark(int r, double xl, double xr) noexcept {
+    void add_pair(int r, int k, double v0, double v1, double w0, double w1) {
+        push(r, k, v0, v1, w0, w1);
+        if (marks != nullptr)
+            marks[static_cast<std::size_t>(r) * words + (static_cast<unsigned>(k) >> 6)] |=
+                std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
+    }
+    // A single addition (at column 0, for the part of an edge left of the sensor, which
+    // covers no pixel of its own) as a pair adding 0 to column 1: adding 0 changes no sum.
+    void add(int r, int k, double v, double w2) { push(r, k, v, 0.0, w2, 0.0); }
+    void span(int r, double, double) noexcept {
+        if (r < y0) y0 = r;
+        if (r > y1) y1 = r;
+    }
+    void flat(double y, double xl, double xr) noexcept {
+        if (marks == nullptr || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
         const double lo_x = xl - kMarkMargin, hi_x = xr + kMarkMargin;
         if (hi_x < 0 || lo_x >= w) return;
         const int lo = lo_x <= 0 ? 0 : static_cast<int>(lo_x);  // truncation is floor for x >= 0
         const int hi = hi_x >= w - 1 ? w - 1 : static_cast<int>(hi_x);
-        set_range(marks + static_cast<std::size_t>(r) * words, lo, hi);
-        if (r < y0) y0 = r;
-        if (r > y1) y1 = r;
-    }
-    // A slanted edge's pieces in row r lie in columns floor(xl) .. floor(xr).
-    void span(int r, double xl, double xr) noexcept {
-        if (marks != nullptr) mark(r, xl, xr);
-    }
-    void flat(double y, double xl, double xr) noexcept {
-        if (marks == nullptr || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
         const int r0 = std::max(0, static_cast<int>(std::floor(y - kMarkMargin)));
         const int r1 = std::min(h - 1, static_cast<int>(std::floor(y + kMarkMargin)));
-        for (int r = r0; r <= r1; ++r) mark(r, xl, xr);
+        for (int r = r0; r <= r1; ++r) {
+            set_range(marks + static_cast<std::size_t>(r) * words, lo, hi);
+            span(r, xl, xr);
+        }
     }
 };
 
 void Simulator::walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1) {
     const Object& obj = scene_.objects[o];
     TermList& list = terms_[o];
-    TermSink sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
-    const bool multi = obj.pieces.size() > 1;
-    for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-        if (multi)
+    if (obj.pieces.size() > 1) {
+        TermSink<true> sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
+        for (std::size_t k = 0; k < obj.pieces.size(); ++k)
             walk_coverage<true>(polys_[o][k], 1.0, obj.pieces[k].intensity, w_, h_, sink);
-        else
-            walk_coverage<false>(polys_[o][k], 1.0, 0.0, w_, h_, sink);
+        list.n = static_cast<std::size_t>(sink.out - list.buf.data());
+    } else {
+        TermSink<false> sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
+        walk_coverage<false>(polys_[o][0], 1.0, 0.0, w_, h_, sink);
+        list.n = static_cast<std::size_t>(sink.out - list.buf.data());
     }
-    list.n = static_cast<std::size_t>(sink.out - list.buf.data());
 }
 
 double Simulator::render(bool all_rows) {
@@ -315,16 +326,17 @@ double Simulator::render(bool all_rows) {
             // row is dirty.
             double b = 0, s = 0;
             for (std::size_t k = k0; k <= k1; ++k) {
-                const std::uint64_t dm = d[k] & word_mask(k, r.x0, r.x1);
-                std::uint64_t m = wr[k] | dm;
+                const std::uint64_t inside = word_mask(k, r.x0, r.x1);
+                const std::uint64_t dm = d[k] & inside;
+                for (std::uint64_t m = wr[k] & ~inside; m != 0; m &= m - 1) {
+                    const int x = static_cast<int>(k * 64) + std::countr_zero(m);
+                    ac[x] = 0;
+                    if (multi) ai[x] = 0;
+                }
+                std::uint64_t m = (wr[k] & inside) | dm;
                 wr[k] = 0;
                 for (; m != 0; m &= m - 1) {
                     const int x = static_cast<int>(k * 64) + std::countr_zero(m);
-                    if (x < r.x0 || x > r.x1) {
-                        ac[x] = 0;
-                        if (multi) ai[x] = 0;
-                        continue;
-                    }
                     b += ac[x];
                     ac[x] = 0;
                     if (multi) {

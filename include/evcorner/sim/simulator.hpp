@@ -81,6 +81,7 @@ private:
         std::vector<Term> buf;
         std::size_t n = 0;
     };
+    template <bool Dual>
     struct TermSink;
     // Walks object o's edges as placed in polys_ into terms_[o]; with marks, also marks the
     // pixels its edges touch there (rows y0 .. y1 grow to hold them).
