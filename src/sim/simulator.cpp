@@ -247,8 +247,8 @@ double Simulator::render(bool all_rows) {
         dirty_y0_ = 0;
         dirty_y1_ = h_ - 1;
     } else {
-        // The pixels near the moving edges now (cur_marks_) and at time_us() (prev_marks_,
-        // kept from the step that reached it).
+        // The pixels the moving edges pass through now (cur_marks_, marked by their edge
+        // walks) and at time_us() (prev_marks_, kept from the step that reached it).
         for (int y = cur_y0_; y <= cur_y1_; ++y) std::fill_n(row_bits(cur_marks_, y), words_, 0);
         cur_y0_ = h_;
         cur_y1_ = -1;

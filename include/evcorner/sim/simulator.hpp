@@ -21,9 +21,10 @@
 //
 // Streaming: step() hands out one step's events at a time; memory is a few arrays the size
 // of the sensor, whatever the duration. Steps are also short enough that no vertex moves
-// 0.75 px; then only the pixels within a pixel of a moving edge (before or after the step)
-// can change, and only they are recomputed: the work per step follows the edges' length,
-// not the objects' area.
+// 0.75 px; then only the pixels a moving edge passes through (before or after the step) can
+// change, and only they are recomputed (kept as per-row bitmaps; each object's coverage is
+// summed along a row only at the columns its edges wrote): the work per step follows the
+// edges' length, not the objects' area.
 
 #include <cstdint>
 #include <span>
