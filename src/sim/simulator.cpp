@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include "evcorner/sim/coverage_walk.hpp"
 #include "evcorner/sim/motion.hpp"
@@ -59,6 +61,10 @@ Simulator::Simulator(Scene scene)
       end_(static_cast<double>(scene_.duration_us())),
       noise_rng_(scene_.seed, kSaltNoise) {
     const std::size_t n = static_cast<std::size_t>(scene_.sensor.pixels());
+    // Pixels, accumulator cells and bitmap bits are indexed with 32 bits (Term, changed_).
+    if (std::max(stride_, words_ * 64) * static_cast<std::size_t>(h_) > UINT32_MAX)
+        throw std::length_error("simulate: a " + std::to_string(w_) + "x" + std::to_string(h_) +
+                                " sensor is too large for the simulator (at most about 4.29e9 pixels)");
     bg_ = background_image(scene_.background, scene_.sensor, scene_.seed);
     cur_.assign(n, 0.0);
     next_.assign(n, 0.0);
