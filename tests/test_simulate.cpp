@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <span>
 #include <string>
 
 #include "evcorner/error.hpp"
@@ -239,8 +240,36 @@ TEST(SimulateStreaming, StepsComeInTimeOrderAndRespectTheRefractoryPeriod) {
     }
 }
 
-// The image the simulator keeps (recomputed only near moving edges) against a full render
-// at the same time: background, then every object composited with polygon_coverage().
+// A full render at the simulator's time: background, then every object composited with
+// polygon_coverage().
+std::vector<double> full_render(const Scene& s, double t_us) {
+    std::vector<double> img = background_image(s.background, s.sensor, s.seed);
+    const double t_s = t_us / 1e6;
+    for (const Object& o : s.objects) {
+        const Pose pose(o.motion, t_s, s.duration_s);
+        std::vector<double> b(img.size(), 0.0), sum(img.size(), 0.0);
+        for (const Piece& p : o.pieces) {
+            std::vector<Vec2> poly;
+            for (const Vec2& v : p.polygon) poly.push_back(pose.apply(v));
+            const std::vector<double> c = polygon_coverage(poly, s.sensor);
+            for (std::size_t i = 0; i < c.size(); ++i) {
+                b[i] += c[i];
+                sum[i] += c[i] * p.intensity;
+            }
+        }
+        for (std::size_t i = 0; i < img.size(); ++i) img[i] = img[i] * (1 - b[i]) + sum[i];
+    }
+    return img;
+}
+
+double largest_difference(std::span<const double> a, const std::vector<double>& b) {
+    double worst = 0;
+    for (std::size_t i = 0; i < b.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+    return worst;
+}
+
+// The image the simulator keeps (recomputed only at the pixels the moving edges touch before
+// or after a step) against a full render at the same time.
 TEST(SimulateStreaming, ImageNearEdgesOnlyEqualsAFullRender) {
     const Scene s = parse_scene(busy(4), "busy");
     Simulator sim(s);
@@ -248,29 +277,46 @@ TEST(SimulateStreaming, ImageNearEdgesOnlyEqualsAFullRender) {
     int checked = 0;
     for (int k = 0; sim.step(sink); ++k) {
         if (k % 37 != 0) continue;
-        std::vector<double> img = background_image(s.background, s.sensor, s.seed);
-        const double t_s = sim.time_us() / 1e6;
-        for (const Object& o : s.objects) {
-            const Pose pose(o.motion, t_s, s.duration_s);
-            std::vector<double> b(img.size(), 0.0), sum(img.size(), 0.0);
-            for (const Piece& p : o.pieces) {
-                std::vector<Vec2> poly;
-                for (const Vec2& v : p.polygon) poly.push_back(pose.apply(v));
-                const std::vector<double> c = polygon_coverage(poly, s.sensor);
-                for (std::size_t i = 0; i < c.size(); ++i) {
-                    b[i] += c[i];
-                    sum[i] += c[i] * p.intensity;
-                }
-            }
-            for (std::size_t i = 0; i < img.size(); ++i) img[i] = img[i] * (1 - b[i]) + sum[i];
-        }
-        const auto got = sim.image();
-        double worst = 0;
-        for (std::size_t i = 0; i < img.size(); ++i) worst = std::max(worst, std::abs(got[i] - img[i]));
-        EXPECT_LT(worst, 1e-9) << "at " << sim.time_us() << " us";
+        EXPECT_LT(largest_difference(sim.image(), full_render(s, sim.time_us())), 1e-9) << "at " << sim.time_us() << " us";
         ++checked;
     }
     EXPECT_GT(checked, 10);
+}
+
+// The same at every step of a scene made to find a pixel the dirty set could miss: horizontal
+// and vertical edges on pixel lines at t = 0 (a rectangle moving straight down, its top and
+// bottom edges horizontal), an object leaving the sensor over its left and top borders, a
+// still object under and over moving ones, a turning, growing checkerboard and a thin sliver.
+constexpr const char* kEdgeCases = R"({
+  "sensor": [64, 48], "duration_s": 0.25, "background": 0.3,
+  "objects": [
+    {"polygon": [[10, 8], [30, 8], [30, 20], [10, 20]], "intensity": 0.9,
+     "motion": {"velocity": [0, 37]}},
+    {"polygon": [[20, 30], [44, 26], [36, 44]], "intensity": 0.6},
+    {"polygon": [[4, 3], [14, 5], [6, 12]], "intensity": 0.05,
+     "motion": {"velocity": [-90, -60], "rotation_deg_s": 200}},
+    {"checkerboard": {"origin": [34, 6], "square": 5, "cols": 3, "rows": 3}, "intensity": [0.1, 0.8],
+     "motion": {"rotation_deg_s": 90, "scaling_per_s": 0.8}},
+    {"polygon": [[5, 40], [60, 41.5], [5, 40.2]], "intensity": 1.0,
+     "motion": {"velocity": [0, -20], "rotation_deg_s": -15}},
+    {"polygon": [[40, 34], [50, 34], [50, 44], [40, 44]], "intensity": 0.45}
+  ]
+})";
+
+TEST(SimulateStreaming, ImageEqualsAFullRenderAtEveryStepOfTheEdgeCases) {
+    const Scene s = parse_scene(kEdgeCases, "edge cases");
+    Simulator sim(s);
+    EXPECT_LT(largest_difference(sim.image(), full_render(s, 0.0)), 1e-9);
+    std::vector<Event> events;
+    int steps = 0;
+    double worst = 0;
+    while (sim.step(events)) {
+        worst = std::max(worst, largest_difference(sim.image(), full_render(s, sim.time_us())));
+        ++steps;
+    }
+    EXPECT_LT(worst, 1e-9);
+    EXPECT_GT(steps, 100);
+    EXPECT_GT(events.size(), 1000u);
 }
 
 // Random simple polygons, convex or not: star-shaped around a centre.

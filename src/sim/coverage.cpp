@@ -2,123 +2,45 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+
+#include "evcorner/sim/coverage_walk.hpp"
 
 namespace evcorner::sim {
 
 namespace {
 
-// One edge from (x0, y0) to (x1, y1), y0 < y1; h for a row is sign * its y-extent there.
-// Dual: the same edge also into acc2 with sign2, every value computed as a pass of its own
-// would (the same operations in the same order), so that one walk serves both.
-template <bool Record, bool Dual = false>
-void accumulate_edge(double x0, double y0, double x1, double y1, double sign, double* acc, std::size_t stride, int width,
-                     int height, std::vector<std::vector<int>>* touched, double sign2 = 0,
-                     double* acc2 = nullptr) noexcept {
-    const double dxdy = (x1 - x0) / (y1 - y0);
-    const int r0 = std::max(0, static_cast<int>(std::floor(y0)));
-    const int r1 = std::min(height - 1, static_cast<int>(std::ceil(y1)) - 1);
-    for (int r = r0; r <= r1; ++r) {
-        const double ya = std::max(y0, static_cast<double>(r));
-        const double yb = std::min(y1, static_cast<double>(r + 1));
-        if (yb <= ya) continue;
-        const double h = sign * (yb - ya);
-        double* row = acc + static_cast<std::size_t>(r) * stride;
-        [[maybe_unused]] const double h2 = Dual ? sign2 * (yb - ya) : 0.0;
-        [[maybe_unused]] double* row2 = Dual ? acc2 + static_cast<std::size_t>(r) * stride : nullptr;
-        [[maybe_unused]] std::vector<int>* cols = Record ? &(*touched)[static_cast<std::size_t>(r)] : nullptr;
-        const double xa = x0 + (ya - y0) * dxdy, xb = x0 + (yb - y0) * dxdy;
-        const double xl = std::min(xa, xb), xr = std::max(xa, xb);
-        if (xr <= 0) {  // wholly left of the sensor: covers every pixel of the row to its right
-            row[0] += h;
-            if constexpr (Dual) row2[0] += h2;
-            if constexpr (Record) cols->push_back(0);
-            continue;
-        }
-        if (xl >= width) continue;
-        if (xr == xl) {
-            const int k = static_cast<int>(std::floor(xl));
-            row[k] += h * (k + 1 - xl);
-            row[k + 1] += h * (xl - k);
-            if constexpr (Dual) {
-                row2[k] += h2 * (k + 1 - xl);
-                row2[k + 1] += h2 * (xl - k);
-            }
-            if constexpr (Record) {
-                cols->push_back(k);
-                cols->push_back(k + 1);
-            }
-            continue;
-        }
-        const double per_x = h / (xr - xl);
-        [[maybe_unused]] const double per_x2 = Dual ? h2 / (xr - xl) : 0.0;
-        double lo = xl;
-        if (lo < 0) {
-            row[0] += per_x * (0 - lo);
-            if constexpr (Dual) row2[0] += per_x2 * (0 - lo);
-            if constexpr (Record) cols->push_back(0);
-            lo = 0;
-        }
-        const double hi_end = std::min(xr, static_cast<double>(width));
-        int k = static_cast<int>(std::floor(lo));
-        while (lo < hi_end) {
-            const double hi = std::min(hi_end, static_cast<double>(k + 1));
-            const double hp = per_x * (hi - lo);
-            const double xm = 0.5 * (lo + hi);
-            row[k] += hp * (k + 1 - xm);
-            row[k + 1] += hp * (xm - k);
-            if constexpr (Dual) {
-                const double hp2 = per_x2 * (hi - lo);
-                row2[k] += hp2 * (k + 1 - xm);
-                row2[k + 1] += hp2 * (xm - k);
-            }
-            if constexpr (Record) {
-                cols->push_back(k);
-                cols->push_back(k + 1);
-            }
-            lo = hi;
-            ++k;
-        }
+// Adds into one or two dense arrays of `stride` doubles per row.
+template <bool Dual>
+struct DenseSink {
+    double* acc;
+    double* acc2;
+    std::size_t stride;
+    void add(int r, int k, double v, double v2) noexcept {
+        const std::size_t i = static_cast<std::size_t>(r) * stride + static_cast<std::size_t>(k);
+        acc[i] += v;
+        if constexpr (Dual) acc2[i] += v2;
     }
-}
-
-template <bool Record>
-void accumulate(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width, int height,
-                std::vector<std::vector<int>>* touched) noexcept {
-    const std::size_t n = poly.size();
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec2 a = poly[i], b = poly[(i + 1) % n];
-        if (a.y == b.y) continue;  // horizontal edges bound no area to their right
-        // Upward edges (b.y < a.y) add, downward ones subtract: a positive-area polygon covers +1.
-        if (a.y < b.y)
-            accumulate_edge<Record>(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height, touched);
-        else
-            accumulate_edge<Record>(b.x, b.y, a.x, a.y, weight, acc, stride, width, height, touched);
+    void add_pair(int r, int k, double v0, double v1, double w0, double w1) noexcept {
+        add(r, k, v0, w0);
+        add(r, k + 1, v1, w1);
     }
-}
+    void span(int, double, double) noexcept {}
+    void flat(double, double, double) noexcept {}
+};
 
 }  // namespace
 
 void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
                         int height) noexcept {
-    accumulate<false>(poly, weight, acc, stride, width, height, nullptr);
+    DenseSink<false> sink{acc, nullptr, stride};
+    walk_coverage<false>(poly, weight, 0.0, width, height, sink);
 }
 
 void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
                          std::size_t stride, int width, int height) noexcept {
-    const std::size_t n = poly.size();
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec2 a = poly[i], b = poly[(i + 1) % n];
-        if (a.y == b.y) continue;
-        if (a.y < b.y)
-            accumulate_edge<false, true>(a.x, a.y, b.x, b.y, -weight, acc, stride, width, height, nullptr, -weight2, acc2);
-        else
-            accumulate_edge<false, true>(b.x, b.y, a.x, a.y, weight, acc, stride, width, height, nullptr, weight2, acc2);
-    }
-}
-
-void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
-                        int height, std::vector<std::vector<int>>& touched) {
-    accumulate<true>(poly, weight, acc, stride, width, height, &touched);
+    DenseSink<true> sink{acc, acc2, stride};
+    walk_coverage<true>(poly, weight, weight2, width, height, sink);
 }
 
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size) {

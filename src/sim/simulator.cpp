@@ -1,11 +1,15 @@
 #include "evcorner/sim/simulator.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <climits>
 #include <cmath>
+#include <cstdint>
 #include <set>
+#include <stdexcept>
+#include <string>
 
-#include "evcorner/sim/coverage.hpp"
+#include "evcorner/sim/coverage_walk.hpp"
 #include "evcorner/sim/motion.hpp"
 #include "evcorner/sim/texture.hpp"
 
@@ -19,19 +23,31 @@ constexpr double kSnap = 1e-12;
 constexpr double kMaxMove = 0.75;
 constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
 
-// Sorts a row's spans and merges those that overlap or touch: the canonical form of the set
-// of columns they cover (the same set gives the same spans, whatever the order given).
-void canonical_spans(std::vector<std::pair<int, int>>& row) {
-    if (row.size() < 2) return;
-    std::sort(row.begin(), row.end());
-    std::size_t k = 0;
-    for (std::size_t i = 1; i < row.size(); ++i) {
-        if (row[i].first <= row[k].second + 1)
-            row[k].second = std::max(row[k].second, row[i].second);
-        else
-            row[++k] = row[i];
+// Horizontal edges are widened by this much (px) when marking the pixels they touch, so that
+// rounding never leaves out a pixel one grazes (an extra pixel costs only time).
+constexpr double kMarkMargin = 1e-7;
+
+// Sets bits lo .. hi (inclusive) of a bitmap row.
+inline void set_range(std::uint64_t* row, int lo, int hi) noexcept {
+    const unsigned wl = static_cast<unsigned>(lo) >> 6, wh = static_cast<unsigned>(hi) >> 6;
+    const std::uint64_t ml = ~std::uint64_t{0} << (static_cast<unsigned>(lo) & 63u);
+    const std::uint64_t mh = ~std::uint64_t{0} >> (63u - (static_cast<unsigned>(hi) & 63u));
+    if (wl == wh) {
+        row[wl] |= ml & mh;
+        return;
     }
-    row.resize(k + 1);
+    row[wl] |= ml;
+    for (unsigned k = wl + 1; k < wh; ++k) row[k] = ~std::uint64_t{0};
+    row[wh] |= mh;
+}
+
+// The bits of word k of a row that lie within columns lo .. hi.
+inline std::uint64_t word_mask(std::size_t k, int lo, int hi) noexcept {
+    const long base = static_cast<long>(k) * 64;
+    if (hi < base || lo >= base + 64) return 0;
+    const unsigned l = lo <= base ? 0u : static_cast<unsigned>(lo - base);
+    const unsigned h = hi >= base + 63 ? 63u : static_cast<unsigned>(hi - base);
+    return (~std::uint64_t{0} << l) & (~std::uint64_t{0} >> (63u - h));
 }
 }  // namespace
 
@@ -40,36 +56,47 @@ Simulator::Simulator(Scene scene)
       w_(scene_.sensor.width),
       h_(scene_.sensor.height),
       stride_(static_cast<std::size_t>(w_) + 2),
+      words_(static_cast<std::size_t>(w_) / 64 + 1),
       dt_(scene_.simulation.max_step_us),
       end_(static_cast<double>(scene_.duration_us())),
       noise_rng_(scene_.seed, kSaltNoise) {
     const std::size_t n = static_cast<std::size_t>(scene_.sensor.pixels());
+    // Pixels, accumulator cells and bitmap bits are indexed with 32 bits (Term, changed_).
+    if (std::max(stride_, words_ * 64) * static_cast<std::size_t>(h_) > UINT32_MAX)
+        throw std::length_error("simulate: a " + std::to_string(w_) + "x" + std::to_string(h_) +
+                                " sensor is too large for the simulator (at most about 4.29e9 pixels)");
     bg_ = background_image(scene_.background, scene_.sensor, scene_.seed);
     cur_.assign(n, 0.0);
     next_.assign(n, 0.0);
     acc_cov_.assign(stride_ * static_cast<std::size_t>(h_), 0.0);
     acc_int_.assign(stride_ * static_cast<std::size_t>(h_), 0.0);
-    spans_.resize(static_cast<std::size_t>(h_));
+    const std::size_t bitmap_words = words_ * static_cast<std::size_t>(h_);
+    cur_marks_.assign(bitmap_words, 0);
+    prev_marks_.assign(bitmap_words, 0);
+    dirty_.assign(bitmap_words, 0);
+    written_.assign(bitmap_words, 0);
+    zero_row_.assign(words_, 0);
     polys_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) polys_[o].resize(scene_.objects[o].pieces.size());
     rects_.resize(scene_.objects.size());
 
     // The image at t = 0, every row dirty.
     place_objects(0.0);
-    prev_rects_ = rects_;
     prev_polys_ = polys_;
     moving_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
         const Motion& m = scene_.objects[o].motion;
         moving_[o] = m.velocity.x != 0 || m.velocity.y != 0 || m.rotation_deg_s != 0 || m.scaling_per_s != 0;
     }
+    // Every object's edge walk at t = 0 (a still object's is kept for the whole run), the
+    // moving ones' edges marked as the pixels near them at time_us().
+    terms_.resize(scene_.objects.size());
+    prev_y0_ = h_;
+    prev_y1_ = -1;
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o)
+        walk_object(o, moving_[o] ? prev_marks_.data() : nullptr, prev_y0_, prev_y1_);
     render(true);
     cur_ = next_;
-    cur_marks_.resize(static_cast<std::size_t>(h_));
-    prev_marks_.resize(static_cast<std::size_t>(h_));
-    for (std::size_t o = 0; o < scene_.objects.size(); ++o)
-        if (moving_[o]) mark_edges(polys_[o], prev_marks_);
-    for (auto& row : prev_marks_) canonical_spans(row);
 
     const CameraParams& cam = scene_.camera;
     lref_.resize(n);
@@ -140,64 +167,117 @@ void Simulator::place_objects(double t_us) {
 }
 
 
-void Simulator::mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::vector<std::vector<std::pair<int, int>>>& spans) {
-    // Every cell an edge touches, widened by one pixel on each side and one row up and down:
-    // with edges moving less than a pixel per step (step()), every pixel whose coverage
-    // changes touches an edge before or after the step.
-    for (const auto& poly : pieces) {
-        const std::size_t n = poly.size();
-        for (std::size_t i = 0; i < n; ++i) {
-            Vec2 a = poly[i], b = poly[(i + 1) % n];
-            if (a.y > b.y) std::swap(a, b);
-            const int r0 = std::max(0, static_cast<int>(std::floor(a.y)) - 1);
-            const int r1 = std::min(h_ - 1, static_cast<int>(std::floor(b.y)) + 1);
-            const double dxdy = b.y > a.y ? (b.x - a.x) / (b.y - a.y) : 0.0;
-            for (int r = r0; r <= r1; ++r) {
-                double xa, xb;
-                if (b.y > a.y) {
-                    const double ya = std::clamp(static_cast<double>(r - 1), a.y, b.y);
-                    const double yb = std::clamp(static_cast<double>(r + 2), a.y, b.y);
-                    xa = a.x + (ya - a.y) * dxdy;
-                    xb = a.x + (yb - a.y) * dxdy;
-                } else {
-                    xa = a.x;
-                    xb = b.x;
-                }
-                const double lo_x = std::min(xa, xb), hi_x = std::max(xa, xb);
-                if (hi_x < -1 || lo_x >= w_ + 1) continue;
-                const int lo = std::max(0, static_cast<int>(std::floor(std::max(lo_x, -2.0))) - 1);
-                const int hi = std::min(w_ - 1, static_cast<int>(std::floor(std::min(hi_x, w_ + 1.0))) + 1);
-                if (lo <= hi) spans[static_cast<std::size_t>(r)].push_back({lo, hi});
-            }
+// Collects an object's edge walk as Terms and, when `marks` is set, marks every pixel an
+// edge passes through in rows [y0, y1], which grow to hold the rows marked: the cell of every
+// piece of a slanted edge (the computed coverage of a pixel without one is a sum of whole
+// piece heights, 0 or 1 up to rounding that kSnap removes) and every cell a horizontal edge
+// meets (widened by kMarkMargin). Edges move less than kMaxMove (< 1 px) per step (step()),
+// so a pixel whose coverage differs between the two ends of a step is touched by an edge at
+// one end: a pixel wholly outside an object at one end and wholly inside at the other would
+// need its boundary to sweep over the whole pixel.
+template <bool Dual>
+struct Simulator::TermSink {
+    TermList& list;
+    Term* out;  // next free term of list.buf
+    Term* cap;  // end of list.buf
+    std::uint64_t* marks;
+    int& y0;
+    int& y1;
+    std::size_t stride, words;
+    int w, h;
+
+    Term* grow() {
+        const std::size_t n = static_cast<std::size_t>(out - list.buf.data());
+        list.buf.resize(std::max<std::size_t>(64, 2 * list.buf.size()));
+        cap = list.buf.data() + list.buf.size();
+        return out = list.buf.data() + n;
+    }
+    void push(int r, int k, double v0, double v1, double w0, double w1) {
+        Term* t = out == cap ? grow() : out;
+        t->cell = static_cast<std::uint32_t>(static_cast<std::size_t>(r) * stride + static_cast<std::size_t>(k));
+        t->row = static_cast<std::uint32_t>(r);
+        t->v0 = v0;
+        t->v1 = v1;
+        if constexpr (Dual) {
+            t->w0 = w0;
+            t->w1 = w1;
         }
+        out = t + 1;
+    }
+    void add_pair(int r, int k, double v0, double v1, double w0, double w1) {
+        push(r, k, v0, v1, w0, w1);
+        if (marks != nullptr)
+            marks[static_cast<std::size_t>(r) * words + (static_cast<unsigned>(k) >> 6)] |=
+                std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
+    }
+    // A single addition (at column 0, for the part of an edge left of the sensor, which
+    // covers no pixel of its own) as a pair adding 0 to column 1: adding 0 changes no sum.
+    void add(int r, int k, double v, double w2) { push(r, k, v, 0.0, w2, 0.0); }
+    void span(int r, double, double) noexcept {
+        if (r < y0) y0 = r;
+        if (r > y1) y1 = r;
+    }
+    void flat(double y, double xl, double xr) noexcept {
+        if (marks == nullptr || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
+        const double lo_x = xl - kMarkMargin, hi_x = xr + kMarkMargin;
+        if (hi_x < 0 || lo_x >= w) return;
+        const int lo = lo_x <= 0 ? 0 : static_cast<int>(lo_x);  // truncation is floor for x >= 0
+        const int hi = hi_x >= w - 1 ? w - 1 : static_cast<int>(hi_x);
+        const int r0 = std::max(0, static_cast<int>(std::floor(y - kMarkMargin)));
+        const int r1 = std::min(h - 1, static_cast<int>(std::floor(y + kMarkMargin)));
+        for (int r = r0; r <= r1; ++r) {
+            set_range(marks + static_cast<std::size_t>(r) * words, lo, hi);
+            span(r, xl, xr);
+        }
+    }
+};
+
+void Simulator::walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1) {
+    const Object& obj = scene_.objects[o];
+    TermList& list = terms_[o];
+    if (obj.pieces.size() > 1) {
+        TermSink<true> sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
+        for (std::size_t k = 0; k < obj.pieces.size(); ++k)
+            walk_coverage<true>(polys_[o][k], 1.0, obj.pieces[k].intensity, w_, h_, sink);
+        list.n = static_cast<std::size_t>(sink.out - list.buf.data());
+    } else {
+        TermSink<false> sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
+        walk_coverage<false>(polys_[o][0], 1.0, 0.0, w_, h_, sink);
+        list.n = static_cast<std::size_t>(sink.out - list.buf.data());
     }
 }
 
 double Simulator::render(bool all_rows) {
-    for (auto& row : spans_) row.clear();
     if (all_rows) {
-        for (auto& row : spans_) row.push_back({0, w_ - 1});
+        for (int y = 0; y < h_; ++y) set_range(row_bits(dirty_, y), 0, w_ - 1);
+        dirty_y0_ = 0;
+        dirty_y1_ = h_ - 1;
     } else {
-        // The pixels near the moving edges now (cur_marks_) and at time_us() (prev_marks_,
-        // kept from the step that reached it): sorted, disjoint spans per row.
-        for (auto& row : cur_marks_) row.clear();
+        // The pixels the moving edges pass through now (cur_marks_, marked by their edge
+        // walks) and at time_us() (prev_marks_, kept from the step that reached it).
+        for (int y = cur_y0_; y <= cur_y1_; ++y) std::fill_n(row_bits(cur_marks_, y), words_, 0);
+        cur_y0_ = h_;
+        cur_y1_ = -1;
         for (std::size_t o = 0; o < rects_.size(); ++o)
-            if (moving_[o]) mark_edges(polys_[o], cur_marks_);
-        for (std::size_t y = 0; y < spans_.size(); ++y) {
-            canonical_spans(cur_marks_[y]);
-            auto& row = spans_[y];
-            row.insert(row.end(), cur_marks_[y].begin(), cur_marks_[y].end());
-            row.insert(row.end(), prev_marks_[y].begin(), prev_marks_[y].end());
-            if (!cur_marks_[y].empty() && !prev_marks_[y].empty()) canonical_spans(row);
-        }
+            if (moving_[o]) walk_object(o, cur_marks_.data(), cur_y0_, cur_y1_);
+        dirty_y0_ = std::min(cur_y0_, prev_y0_);
+        dirty_y1_ = std::max(cur_y1_, prev_y1_);
     }
+    // The dirty pixels start from the background.
     const std::size_t w = static_cast<std::size_t>(w_);
-    for (int y = 0; y < h_; ++y) {
+    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
+        std::uint64_t* d = row_bits(dirty_, y);
+        if (!all_rows) {
+            const std::uint64_t* c = row_bits(cur_marks_, y);
+            const std::uint64_t* p = row_bits(prev_marks_, y);
+            for (std::size_t k = 0; k < words_; ++k) d[k] = c[k] | p[k];
+        }
         const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)])
-            std::copy(bg_.begin() + static_cast<std::ptrdiff_t>(base + static_cast<std::size_t>(lo)),
-                      bg_.begin() + static_cast<std::ptrdiff_t>(base + static_cast<std::size_t>(hi) + 1),
-                      next_.begin() + static_cast<std::ptrdiff_t>(base + static_cast<std::size_t>(lo)));
+        for (std::size_t k = 0; k < words_; ++k)
+            for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
+                const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                next_[i] = bg_[i];
+            }
     }
     // Each object over what lies behind it: I = I (1 - b) + sum_k b_k I_k, b = sum_k b_k, its
     // pieces' coverages (they never overlap, so b is the object's own coverage), evaluated only
@@ -206,73 +286,96 @@ double Simulator::render(bool all_rows) {
         const Rect& r = rects_[o];
         if (r.empty()) continue;
         bool touches = false;
-        for (int y = r.y0; y <= r.y1 && !touches; ++y)
-            for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)]) touches = touches || (hi >= r.x0 && lo <= r.x1);
+        const int ty0 = std::max(r.y0, dirty_y0_), ty1 = std::min(r.y1, dirty_y1_);
+        for (int y = ty0; y <= ty1 && !touches; ++y) {
+            const std::uint64_t* d = row_bits(dirty_, y);
+            for (std::size_t k = static_cast<std::size_t>(r.x0) / 64; k <= static_cast<std::size_t>(r.x1) / 64; ++k)
+                touches = touches || (d[k] & word_mask(k, r.x0, r.x1)) != 0;
+        }
         if (!touches) continue;
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
-        for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-            if (multi)
-                accumulate_polygon2(polys_[o][k], 1.0, acc_cov_.data(), obj.pieces[k].intensity, acc_int_.data(),
-                                    stride_, w_, h_);
-            else
-                accumulate_polygon(polys_[o][k], 1.0, acc_cov_.data(), stride_, w_, h_);
+        // The object's edge walk into the accumulators (the additions in the walk's order,
+        // so each entry gets exactly the sum accumulate_polygon would give it).
+        {
+            double* ac = acc_cov_.data();
+            double* ai = acc_int_.data();
+            std::uint64_t* wr = written_.data();
+            const std::size_t bits_per_row = words_ * 64;
+            const TermList& list = terms_[o];
+            for (const Term* t = list.buf.data(); t != list.buf.data() + list.n; ++t) {
+                ac[t->cell] += t->v0;
+                ac[t->cell + 1] += t->v1;
+                if (multi) {
+                    ai[t->cell] += t->w0;
+                    ai[t->cell + 1] += t->w1;
+                }
+                const std::size_t k = t->cell - static_cast<std::size_t>(t->row) * stride_;
+                const std::size_t bit = static_cast<std::size_t>(t->row) * bits_per_row + k;
+                wr[bit >> 6] |= std::uint64_t{1} << (bit & 63u);
+                wr[(bit + 1) >> 6] |= std::uint64_t{1} << ((bit + 1) & 63u);
+            }
         }
         const double level = obj.pieces[0].intensity;
-        const int xend = std::min(r.x1 + 1, w_);
+        // The accumulation writes columns r.x0 .. r.x1 + 1 (r.x0 - 1 when rounding puts a
+        // vertex on a column line a hair to its left: that entry is cleared, not added).
+        const std::size_t k0 = static_cast<std::size_t>(std::max(0, r.x0 - 1)) / 64;
+        const std::size_t k1 = static_cast<std::size_t>(r.x1 + 1) / 64;
         for (int y = r.y0; y <= r.y1; ++y) {
             double* ac = &acc_cov_[static_cast<std::size_t>(y) * stride_];
             double* ai = &acc_int_[static_cast<std::size_t>(y) * stride_];
             double* out = &next_[static_cast<std::size_t>(y) * w];
-            // The running sums over the object's columns, composited where the row is dirty.
+            std::uint64_t* wr = row_bits(written_, y);
+            const std::uint64_t* d = y >= dirty_y0_ && y <= dirty_y1_ ? row_bits(dirty_, y) : zero_row_.data();
+            // The running sums over the object's columns, in column order: adding 0 leaves a
+            // sum as it is, so only the columns an edge wrote are added; composited where the
+            // row is dirty.
             double b = 0, s = 0;
-            int x = r.x0;
-            for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)]) {
-                if (hi < r.x0) continue;
-                if (lo > r.x1) break;
-                // Adding 0 leaves a sum as it is: only the columns an edge wrote are read.
-                if (multi) {
-                    for (; x < lo; ++x) {
-                        if (ac[x] != 0) b += ac[x], ac[x] = 0;
-                        if (ai[x] != 0) s += ai[x], ai[x] = 0;
-                    }
-                } else {
-                    for (; x < lo; ++x)
-                        if (ac[x] != 0) b += ac[x], ac[x] = 0;
+            for (std::size_t k = k0; k <= k1; ++k) {
+                const std::uint64_t inside = word_mask(k, r.x0, r.x1);
+                const std::uint64_t dm = d[k] & inside;
+                for (std::uint64_t m = wr[k] & ~inside; m != 0; m &= m - 1) {
+                    const int x = static_cast<int>(k * 64) + std::countr_zero(m);
+                    ac[x] = 0;
+                    if (multi) ai[x] = 0;
                 }
-                const int last = std::min(hi, r.x1);
-                for (; x <= last; ++x) {
+                std::uint64_t m = (wr[k] & inside) | dm;
+                wr[k] = 0;
+                for (; m != 0; m &= m - 1) {
+                    const int x = static_cast<int>(k * 64) + std::countr_zero(m);
                     b += ac[x];
                     ac[x] = 0;
                     if (multi) {
                         s += ai[x];
                         ai[x] = 0;
                     }
-                    if (b <= kSnap) continue;
+                    if ((dm & (m & -m)) == 0 || b <= kSnap) continue;
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;
                     out[x] = out[x] * (1.0 - bc) + (multi ? s : bc * level);
                 }
             }
-            // Clear what the edges left to the right of the last dirty column.
-            if (x <= xend) {
-                std::fill(ac + x, ac + xend + 1, 0.0);
-                if (multi) std::fill(ai + x, ai + xend + 1, 0.0);
-            }
         }
     }
-    if (all_rows) return 0;
-    // max |dL| over the dirty pixels, bounded by |dI| / (eps + min I) (log is concave).
+    // The dirty pixels that changed, and max |dL| over them, bounded by |dI| / (eps + min I)
+    // (log is concave).
+    changed_.clear();
     double worst = 0;
-    for (int y = 0; y < h_; ++y) {
+    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
+        const std::uint64_t* d = row_bits(dirty_, y);
         const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)])
-            for (int x = lo; x <= hi; ++x) {
-                const double a = cur_[base + static_cast<std::size_t>(x)], b = next_[base + static_cast<std::size_t>(x)];
+        for (std::size_t k = 0; k < words_; ++k)
+            for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
+                const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                const double a = cur_[i], b = next_[i];
                 if (a == b) continue;
-                worst = std::max(worst, std::abs(a - b) / (kLogEps + std::min(a, b)));
+                changed_.push_back(static_cast<std::uint32_t>(i));
+                // Divides only where the quotient may exceed worst (the slack covers the
+                // product's rounding, so worst ends exactly the largest quotient).
+                const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
+                if (d >= worst * den * (1.0 - 1e-9)) worst = std::max(worst, d / den);
             }
     }
-    return worst;
+    return all_rows ? 0 : worst;
 }
 
 double Simulator::max_displacement() const noexcept {
@@ -292,37 +395,32 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     const double dt = t1 - t0;
     const double refractory = scene_.camera.refractory_us;
     const std::size_t w = static_cast<std::size_t>(w_);
-    auto emit = [&](std::size_t p, double tc, int x, int y, std::uint8_t pol) {
+    auto emit = [&](std::size_t p, double tc, std::uint8_t pol) {
         const std::int64_t ts = std::max<std::int64_t>(1, std::llround(tc));
         if (refractory > 0 && static_cast<double>(ts - last_[p]) < refractory) {
             ++stats_.refractory;
             return;
         }
         last_[p] = ts;
-        ev.push_back({ts, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), pol});
+        ev.push_back({ts, static_cast<std::uint16_t>(p % w), static_cast<std::uint16_t>(p / w), pol});
     };
-    for (int y = 0; y < h_; ++y) {
-        const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (const auto& [lo, hi] : spans_[static_cast<std::size_t>(y)])
-        for (int x = lo; x <= hi; ++x) {
-            const std::size_t p = base + static_cast<std::size_t>(x);
-            const double a = cur_[p], b = next_[p];
-            if (a == b) continue;
-            cur_[p] = b;
-            if (b > a) {
-                while (b >= ion_[p]) {
-                    emit(p, t0 + (ion_[p] - a) / (b - a) * dt, x, y, 1);
-                    lref_[p] += con_[p];
-                    ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
-                    ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
-                }
-            } else {
-                while (b <= ioff_[p]) {
-                    emit(p, t0 + (ioff_[p] - a) / (b - a) * dt, x, y, 0);
-                    lref_[p] -= coff_[p];
-                    ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
-                    ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
-                }
+    for (const std::uint32_t pix : changed_) {
+        const std::size_t p = pix;
+        const double a = cur_[p], b = next_[p];
+        cur_[p] = b;
+        if (b > a) {
+            while (b >= ion_[p]) {
+                emit(p, t0 + (ion_[p] - a) / (b - a) * dt, 1);
+                lref_[p] += con_[p];
+                ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+                ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
+            }
+        } else {
+            while (b <= ioff_[p]) {
+                emit(p, t0 + (ioff_[p] - a) / (b - a) * dt, 0);
+                lref_[p] -= coff_[p];
+                ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+                ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
             }
         }
     }
@@ -384,9 +482,10 @@ bool Simulator::step(std::vector<Event>& out) {
         });
         for (const Event& e : step_events_) ++(e.p ? stats_.on : stats_.off);
         out.insert(out.end(), step_events_.begin(), step_events_.end());
-        prev_rects_ = rects_;
-        prev_polys_ = polys_;
+        prev_polys_.swap(polys_);  // place_objects() overwrites every vertex of polys_
         prev_marks_.swap(cur_marks_);
+        std::swap(prev_y0_, cur_y0_);
+        std::swap(prev_y1_, cur_y1_);
         ++stats_.steps;
         stats_.max_step_change = std::max(stats_.max_step_change, change / scene_.camera.contrast);
         dt_ = std::min(sp.max_step_us, change > 0 ? taken * std::clamp(0.9 * limit / change, 0.5, 2.0) : 2.0 * taken);

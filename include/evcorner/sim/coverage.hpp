@@ -8,8 +8,10 @@
 // column k adds h (k + 1 - xm) to its own cell and h (xm - k) to the next one; the running
 // sum along each row then gives every pixel the area between the edges to its left, exactly
 // (x is linear in y along a piece, so its mean is the midpoint). Work: one cell per piece,
-// plus one addition per pixel of the rows and columns a polygon spans.
+// plus one addition per pixel of the rows and columns a polygon spans. The edge walk itself
+// is walk_coverage() (coverage_walk.hpp).
 
+#include <cstddef>
 #include <span>
 #include <vector>
 
@@ -29,11 +31,6 @@ void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, 
 /// edges; each array gets exactly the values two separate calls would give.
 void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
                          std::size_t stride, int width, int height) noexcept;
-
-/// The same, also appending to touched[r] every column k of row r whose acc entry it changes
-/// (the running sum of a row changes only at those columns).
-void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, std::size_t stride, int width,
-                        int height, std::vector<std::vector<int>>& touched);
 
 /// The coverage of every pixel (row-major, width x height), each in [0, 1].
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size);

@@ -21,9 +21,10 @@
 //
 // Streaming: step() hands out one step's events at a time; memory is a few arrays the size
 // of the sensor, whatever the duration. Steps are also short enough that no vertex moves
-// 0.75 px; then only the pixels within a pixel of a moving edge (before or after the step)
-// can change, and only they are recomputed: the work per step follows the edges' length,
-// not the objects' area.
+// 0.75 px; then only the pixels a moving edge passes through (before or after the step) can
+// change, and only they are recomputed (kept as per-row bitmaps; each object's coverage is
+// summed along a row only at the columns its edges wrote): the work per step follows the
+// edges' length, not the objects' area.
 
 #include <cstdint>
 #include <span>
@@ -69,15 +70,34 @@ private:
         [[nodiscard]] bool empty() const noexcept { return x1 < x0 || y1 < y0; }
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
-    double render(bool all_rows);     // renders into next_ over the dirty rows; returns max |dL| bound
-    void mark_edges(const std::vector<std::vector<Vec2>>& pieces, std::vector<std::vector<std::pair<int, int>>>& spans);
+    double render(bool all_rows);     // renders into next_ over the dirty pixels; returns max |dL| bound
+    // Two additions of an object's edge walk (coverage_walk.hpp): acc_cov_[cell] += v0,
+    // acc_cov_[cell + 1] += v1 (and w0, w1 into acc_int_ for a checkerboard), in sensor row `row`.
+    struct Term {
+        std::uint32_t cell, row;
+        double v0, v1, w0, w1;
+    };
+    // An object's terms: buf holds n of them (buf's size is only the capacity).
+    struct TermList {
+        std::vector<Term> buf;
+        std::size_t n = 0;
+    };
+    template <bool Dual>
+    struct TermSink;
+    // Walks object o's edges as placed in polys_ into terms_[o]; with marks, also marks the
+    // pixels its edges touch there (rows y0 .. y1 grow to hold them).
+    void walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
     void emit_noise(double t1, std::vector<Event>& step_events);
+    [[nodiscard]] std::uint64_t* row_bits(std::vector<std::uint64_t>& bits, int y) noexcept {
+        return bits.data() + static_cast<std::size_t>(y) * words_;
+    }
 
     Scene scene_;
     int w_, h_;
     std::size_t stride_;
+    std::size_t words_;  // 64-bit words per bitmap row: bits for columns 0 .. w_
     double t_ = 0;
     double dt_;
     double end_;
@@ -86,15 +106,21 @@ private:
     std::vector<float> con_, coff_;
     std::vector<std::int64_t> last_;
     std::vector<double> acc_cov_, acc_int_;
-    // Per object: its pieces' polygons at the time being rendered, and the pixel rectangles
-    // it covers then (rects_) and at time_us() (prev_rects_).
+    std::vector<TermList> terms_;  // per object, its edge walk at the time being rendered
+    // Per object: its pieces' polygons at the time being rendered (polys_) and at time_us()
+    // (prev_polys_), and the pixel rectangle it covers at the time being rendered.
     std::vector<std::vector<std::vector<Vec2>>> polys_, prev_polys_;
-    std::vector<Rect> rects_, prev_rects_;
+    std::vector<Rect> rects_;
     std::vector<char> moving_;
-    std::vector<std::vector<std::pair<int, int>>> spans_;  // each row's dirty columns, inclusive, sorted, disjoint
-    // The pixels near the moving edges at the time being rendered and at time_us() (the
-    // previous accepted step's cur_marks_): their union is spans_.
-    std::vector<std::vector<std::pair<int, int>>> cur_marks_, prev_marks_;
+    // Bitmaps, one row of words_ words per sensor row. The pixels the moving edges touch at
+    // the time being rendered (cur_marks_) and at time_us() (prev_marks_, kept from the step
+    // that reached it), each with the range of rows [y0, y1] outside which it is all zero;
+    // dirty_ is their union (valid over dirty_y0_ .. dirty_y1_), the pixels recomputed.
+    // written_: the columns of acc_cov_ / acc_int_ the edge accumulation wrote (all zero
+    // between renders).
+    std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, written_, zero_row_;
+    int cur_y0_ = 0, cur_y1_ = -1, prev_y0_ = 0, prev_y1_ = -1, dirty_y0_ = 0, dirty_y1_ = -1;
+    std::vector<std::uint32_t> changed_;  // the dirty pixels whose next_ differs from cur_
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
     double noise_rate_per_us_ = 0;
