@@ -42,7 +42,8 @@ Harris::Harris(SensorSize size, HarrisParams params, int planes)
     std::uint16_t rows[HarrisScorer::kMaxWindow];
     if (!harris_select_newest(path_, first, sae_.stride(), params_.window, sae_.last(), params_.nl, rows))
         return kNoScore;  // fewer than nl pixels ever fired in the window
-    return scorer_.score(rows);
+    // The AVX2 score with the vector selections (every CPU that runs them runs AVX2).
+    return path_ != HarrisPath::portable && params_.window == 9 ? scorer_.score9_avx2(rows) : scorer_.score(rows);
 }
 
 bool Harris::process_unchecked(const Event& e) noexcept {

@@ -341,7 +341,7 @@ bool cpu_runs(HarrisPath path) noexcept {
         case HarrisPath::portable: return true;
         case HarrisPath::avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
         case HarrisPath::avx512:
-            return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+            return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
                    __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
                    __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("popcnt");
     }

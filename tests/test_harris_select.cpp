@@ -1,12 +1,14 @@
 // The newest-nl selection of the adaptive Harris detector (harris_select.hpp), every code
 // path this CPU runs, against a full sort of the window: drawn windows of random sequence
 // numbers with recent, octave-spread and never-fired cells, streams far past 2^31 and 2^32
-// events (31-bit ages capped, the exact fallback), every nl, several window sizes.
+// events (31-bit ages capped, the exact fallback), every nl, several window sizes; and the
+// AVX2 9x9 score against the portable one.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <random>
 #include <set>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "evcorner/harris.hpp"
+#include "evcorner/harris_score.hpp"
 #include "evcorner/harris_select.hpp"
 
 namespace evcorner {
@@ -111,6 +114,21 @@ TEST(HarrisSelect, EveryPathLightsTheNewestCellsOfDrawnWindows) {
     EXPECT_GT(lit, 10000u);
     EXPECT_GT(too_few, 1000u);
     RecordProperty("compared", static_cast<int>(compared));
+}
+
+TEST(HarrisScorer, Avx2ScoreEqualsThePortableOneBitForBit) {
+    const auto paths = harris_code_paths();
+    if (std::find(paths.begin(), paths.end(), "avx2") == paths.end()) GTEST_SKIP() << "this CPU has no AVX2";
+    std::mt19937_64 rng(9);
+    for (const double k : {0.04, 0.0, 0.15}) {
+        const HarrisScorer scorer(9, k);
+        for (int i = 0; i < 200000; ++i) {
+            std::uint16_t rows[9];
+            for (auto& r : rows) r = static_cast<std::uint16_t>(rng() & (i % 3 == 0 ? 0xFFFFu : 511u));  // high bits ignored
+            const double portable = scorer.score(rows), avx2 = scorer.score9_avx2(rows);
+            ASSERT_EQ(std::memcmp(&portable, &avx2, sizeof portable), 0) << "patch " << i << ": " << portable << " " << avx2;
+        }
+    }
 }
 
 TEST(HarrisSelect, PathsAreNamedAndCheckedAgainstTheCpu) {
