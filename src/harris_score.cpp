@@ -4,6 +4,11 @@
 #include <stdexcept>
 #include <string>
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define EVCORNER_HARRIS_SCORE_AVX2 1
+#endif
+
 namespace evcorner {
 
 HarrisScorer::HarrisScorer(int window, double k) : window_(window), k_(k) {
@@ -77,6 +82,10 @@ double HarrisScorer::score9(const std::uint16_t* rows) const noexcept {
             sc[k] += iy * iy;
         }
     }
+    return weighted9(sa, sb, sc);
+}
+
+double HarrisScorer::weighted9(const std::int64_t* sa, const std::int64_t* sb, const std::int64_t* sc) const noexcept {
     double a = 0, b = 0, cc = 0;
     for (int k = 0; k < 6; ++k) {
         a += h9_[k] * static_cast<double>(sa[k]);
@@ -89,6 +98,82 @@ double HarrisScorer::score9(const std::uint16_t* rows) const noexcept {
     cc /= kScale2;
     return a * cc - b * b - k_ * (a + cc) * (a + cc);
 }
+
+#ifdef EVCORNER_HARRIS_SCORE_AVX2
+namespace {
+
+// Per 9-bit row, the five 5-wide runs' correlations with the taps as int16 lanes 0..4
+// (lanes 5..7 zero): lane c = run at column c.
+struct RunTables {
+    alignas(16) std::int16_t smooth[512][8];
+    alignas(16) std::int16_t deriv[512][8];
+};
+constexpr RunTables make_run_tables() {
+    RunTables t{};
+    for (unsigned bits = 0; bits < 512; ++bits)
+        for (unsigned c = 0; c < 5; ++c) {
+            int sm = 0, de = 0;
+            for (unsigned j = 0; j < 5; ++j)
+                if (bits >> (c + j) & 1u) {
+                    sm += kHarrisSmooth[j];
+                    de += kHarrisDeriv[j];
+                }
+            t.smooth[bits][c] = static_cast<std::int16_t>(sm);
+            t.deriv[bits][c] = static_cast<std::int16_t>(de);
+        }
+    return t;
+}
+constexpr RunTables kRuns = make_run_tables();
+
+}  // namespace
+
+// Lanes = columns 0..4 of a gradient row (5..7 zero). 12 Ix and 12 Iy of the five rows,
+// their products, then folded: rows r and 4 - r share their weights, and columns c and
+// 4 - c, so the rows are added pairwise and lane c gets lane 4 - c: lanes 0, 1, 2 of the
+// three folded vectors (|row - 2| = 2, 1, 0) hold the sums at |column - 2| = 2, 1, 0.
+[[gnu::target("avx2")]] double HarrisScorer::score9_avx2(const std::uint16_t* rows) const noexcept {
+    __m256i sm[9], de[9];
+    for (int r = 0; r < 9; ++r) {
+        const unsigned bits = rows[r] & 511u;
+        sm[r] = _mm256_cvtepi16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(kRuns.smooth[bits])));
+        de[r] = _mm256_cvtepi16_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(kRuns.deriv[bits])));
+    }
+    __m256i xx[5], xy[5], yy[5];
+    for (int r = 0; r < 5; ++r) {
+        const __m256i mid = de[r + 2];
+        const __m256i ix = _mm256_add_epi32(
+            _mm256_add_epi32(_mm256_add_epi32(de[r], de[r + 4]), _mm256_slli_epi32(_mm256_add_epi32(de[r + 1], de[r + 3]), 2)),
+            _mm256_add_epi32(_mm256_slli_epi32(mid, 2), _mm256_slli_epi32(mid, 1)));
+        const __m256i iy = _mm256_add_epi32(_mm256_sub_epi32(sm[r], sm[r + 4]),
+                                            _mm256_slli_epi32(_mm256_sub_epi32(sm[r + 1], sm[r + 3]), 1));
+        xx[r] = _mm256_mullo_epi32(ix, ix);
+        xy[r] = _mm256_mullo_epi32(ix, iy);
+        yy[r] = _mm256_mullo_epi32(iy, iy);
+    }
+    const __m256i mirror = _mm256_setr_epi32(4, 3, 5, 5, 5, 5, 5, 5);  // lane 5 is zero
+    alignas(16) std::int32_t f[3][3][4];  // [quantity][|row - 2|: 2, 1, 0][lane]
+    const __m256i* const p[3] = {xx, xy, yy};
+    for (int q = 0; q < 3; ++q) {
+        const __m256i folded[3] = {_mm256_add_epi32(p[q][0], p[q][4]), _mm256_add_epi32(p[q][1], p[q][3]), p[q][2]};
+        for (int a = 0; a < 3; ++a)
+            _mm_store_si128(reinterpret_cast<__m128i*>(f[q][a]),
+                            _mm256_castsi256_si128(_mm256_add_epi32(folded[a], _mm256_permutevar8x32_epi32(folded[a], mirror))));
+    }
+    // Weight classes by squared distance 0, 1, 2, 4, 5, 8 (score9's kClass): f[q][2 - ar][2 - ac].
+    std::int64_t sums[3][6];
+    for (int q = 0; q < 3; ++q) {
+        sums[q][0] = f[q][2][2];
+        sums[q][1] = std::int64_t{f[q][2][1]} + f[q][1][2];
+        sums[q][2] = f[q][1][1];
+        sums[q][3] = std::int64_t{f[q][2][0]} + f[q][0][2];
+        sums[q][4] = std::int64_t{f[q][1][0]} + f[q][0][1];
+        sums[q][5] = f[q][0][0];
+    }
+    return weighted9(sums[0], sums[1], sums[2]);
+}
+#else
+double HarrisScorer::score9_avx2(const std::uint16_t* rows) const noexcept { return score(rows); }
+#endif
 
 template <int W>
 double HarrisScorer::score_fixed(const std::uint16_t* rows) const noexcept {

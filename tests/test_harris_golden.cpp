@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "evcorner/harris.hpp"
@@ -48,26 +49,31 @@ TEST_P(HarrisGolden, CornersAndScoresMatchTheReference) {
     const std::vector<double> scores = read_scores_gz(golden_dir / (file.golden_prefix + ".harris.scores.gz"));
     ASSERT_EQ(scores.size(), events.size());
 
-    Harris det(kDavis240);
-    std::vector<std::uint64_t> corners;
-    double worst = 0;
-    std::size_t worst_at = 0, score_mismatches = 0;
-    for (std::size_t i = 0; i < events.size(); ++i) {
-        if (det.process(events[i])) corners.push_back(i);
-        const double s = std::isnan(det.last_score()) ? -2.0 : det.last_score();
-        const double diff = std::abs(s - scores[i]);
-        if (diff > worst) {
-            worst = diff;
-            worst_at = i;
+    // Every selection code this CPU runs (harris_select.hpp), the default first.
+    for (const std::string& path : harris_code_paths()) {
+        Harris det(kDavis240);
+        det.set_code_path(harris_path_named(path));
+        std::vector<std::uint64_t> corners;
+        double worst = 0;
+        std::size_t worst_at = 0, score_mismatches = 0;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            if (det.process(events[i])) corners.push_back(i);
+            const double s = std::isnan(det.last_score()) ? -2.0 : det.last_score();
+            const double diff = std::abs(s - scores[i]);
+            if (diff > worst) {
+                worst = diff;
+                worst_at = i;
+            }
+            if (diff > 1e-6 && ++score_mismatches <= 5)
+                ADD_FAILURE() << file.golden_prefix << " " << path << " event " << i << ": score " << s << ", golden "
+                              << scores[i];
         }
-        if (diff > 1e-6 && ++score_mismatches <= 5)
-            ADD_FAILURE() << file.golden_prefix << " event " << i << ": score " << s << ", golden " << scores[i];
+        EXPECT_EQ(score_mismatches, 0u) << path;
+        EXPECT_EQ(corners, expected) << file.golden_prefix << " " << path << ": " << corners.size()
+                                     << " corners, golden " << expected.size();
+        std::printf("[ harris   ] %-45s %-8s %5zu corners (golden %5zu), largest score difference %.3g (event %zu)\n",
+                    file.golden_prefix.c_str(), path.c_str(), corners.size(), expected.size(), worst, worst_at);
     }
-    EXPECT_EQ(score_mismatches, 0u);
-    EXPECT_EQ(corners, expected) << file.golden_prefix << ": " << corners.size() << " corners, golden "
-                                 << expected.size();
-    std::printf("[ harris   ] %-45s %5zu corners (golden %5zu), largest score difference %.3g (event %zu)\n",
-                file.golden_prefix.c_str(), corners.size(), expected.size(), worst, worst_at);
 }
 
 INSTANTIATE_TEST_SUITE_P(Ecd, HarrisGolden, ::testing::ValuesIn(test::ecd_text_files()),

@@ -8,7 +8,7 @@
 //
 // State: an arrival-ordered SAE (per pixel and polarity, the sequence number of its
 // latest event). The Nl newest pixels of a window are selected from the w*w sequence
-// numbers directly; no lists, no allocation per event.
+// numbers directly (harris_select.hpp); no lists, no allocation per event.
 
 #include <cstddef>
 #include <cstdint>
@@ -18,6 +18,7 @@
 #include "evcorner/event.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/harris_score.hpp"
+#include "evcorner/harris_select.hpp"
 #include "evcorner/scored_detector.hpp"
 #include "evcorner/sensor.hpp"
 
@@ -79,6 +80,12 @@ public:
     [[nodiscard]] const ArrivalSae& sae() const noexcept { return sae_; }
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
 
+    /// The code that selects the window's newest pixels (harris_select.hpp): chosen at
+    /// construction (harris_default_path()); set_code_path() picks another one the CPU runs
+    /// (harris_path_named()), for tests and benchmarks. Every path lights the same pixels.
+    [[nodiscard]] HarrisPath code_path() const noexcept { return path_; }
+    void set_code_path(HarrisPath path) noexcept { path_ = path; }
+
 private:
     [[nodiscard]] double score_window(const Event& e) const noexcept;
 
@@ -86,14 +93,14 @@ private:
     HarrisScorer scorer_;
     ArrivalSae sae_;
     int radius_;
-    bool avx512_;  // the 9x9 window's AVX-512 selection (harris_code_path())
+    HarrisPath path_;
     double score_ = kNoScore;
 };
 static_assert(ScoredDetector<Harris>);
 
-/// The code that selects a 9x9 window's newest pixels: "avx512" where the CPU runs it
-/// (the environment variable EVCORNER_HARRIS_PATH=portable forces the portable code),
-/// else "portable"; other windows always take the portable code. Same lit pixels either way.
+/// The name of the code that selects a 9x9 window's newest pixels in a new Harris
+/// (harris_default_path(): the fastest this CPU runs, or EVCORNER_HARRIS_PATH=portable|avx2|avx512);
+/// other windows always take the portable code. Same lit pixels either way.
 const char* harris_code_path() noexcept;
 
 }  // namespace evcorner

@@ -41,11 +41,17 @@ public:
 
     /// The score of the patch whose row r is `rows[r]` (window() rows).
     [[nodiscard]] double score(const std::uint16_t* rows) const noexcept;
+    /// score() of a 9x9 patch with AVX2 vectors: the same value bit for bit (the same integer
+    /// sums per Gaussian weight, weighted in the same order). Only on a CPU that runs AVX2
+    /// (elsewhere, and in builds for other CPUs, it is score()).
+    [[nodiscard]] double score9_avx2(const std::uint16_t* rows) const noexcept;
 
 private:
     template <int W>
     [[nodiscard]] double score_fixed(const std::uint16_t* rows) const noexcept;
     [[nodiscard]] double score9(const std::uint16_t* rows) const noexcept;
+    // The 6 sums per Gaussian weight class of 144 Ix^2, 144 Ix Iy, 144 Iy^2 -> the score.
+    [[nodiscard]] double weighted9(const std::int64_t* sa, const std::int64_t* sb, const std::int64_t* sc) const noexcept;
 
     int window_;
     double k_;
