@@ -85,16 +85,21 @@ bool FaHarris::process_with(const Event& e) noexcept {
 
 namespace {
 
+// Boundary cells up to this many are ranked by all pairs, more by std::nth_element.
+constexpr int kPairwiseMax = 16;
+
 // The nl newest filtered pixels of the window, without sorting. Every cell gets a byte
 // code monotone in its age newest - t: the exponent and the three top mantissa bits of
 // the age as a double (eighths of octaves up to 35 minutes, then one code for all older
 // cells and the never-fired ones, stored 0, which are older than every fired one;
-// rounding keeps the order, and ties within a code are resolved exactly below). The boundary code, the first where the count of cells at least
-// as new reaches nl, is found by a binary search over the 256 codes, each step one
-// branch-free count over the window (vectorised). Every cell of a newer code is lit; of
-// the m cells (a few) of the boundary code the `take` newest are lit, ranked exactly by
-// (age, later arrival first) with branch-free comparisons of all pairs (no sort: its
-// branches mispredicted on every candidate). W: the window side, 0 = the `window` given.
+// rounding keeps the order, and ties within a code are resolved exactly below). The
+// boundary code, the first where the count of cells at least as new reaches nl, is found
+// by a binary search over the 256 codes, each step one branch-free count over the window
+// (vectorised). Every cell of a newer code is lit; of the m cells (a few) of the boundary
+// code the `take` newest are lit, ranked exactly by (age, later arrival first) with
+// branch-free comparisons of all pairs (a sort's branches mispredicted on every
+// candidate); only for many cells of one code (equal times), a partition.
+// W: the window side, 0 = the `window` given.
 template <int W>
 double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, std::size_t stride,
                           std::int64_t newest, int window, int nl, const HarrisScorer& scorer) noexcept {
@@ -188,12 +193,26 @@ double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, 
         key_age[j] = age[i];
         key_seq[j] = seqs[static_cast<std::size_t>(i / w) * stride + static_cast<std::size_t>(i % w)];
     }
-    for (int j = 0; j < m; ++j) {
-        int ahead = 0;
-        for (int k = 0; k < m; ++k)
-            ahead += (key_age[k] < key_age[j]) | ((key_age[k] == key_age[j]) & (key_seq[k] > key_seq[j]));
-        const int i = where[j];
-        rows[i / w] |= static_cast<std::uint16_t>(static_cast<unsigned>(ahead < take) << (i % w));
+    if (m <= kPairwiseMax) {
+        for (int j = 0; j < m; ++j) {
+            int ahead = 0;
+            for (int k = 0; k < m; ++k)
+                ahead += (key_age[k] < key_age[j]) | ((key_age[k] == key_age[j]) & (key_seq[k] > key_seq[j]));
+            const int i = where[j];
+            rows[i / w] |= static_cast<std::uint16_t>(static_cast<unsigned>(ahead < take) << (i % w));
+        }
+    } else {
+        // Many cells of one code (equal times: a busy recording's microseconds): all pairs
+        // would cost m^2, so select the `take` newest by partition instead.
+        std::uint8_t order[kCells];
+        for (int j = 0; j < m; ++j) order[j] = static_cast<std::uint8_t>(j);
+        std::nth_element(order, order + (take - 1), order + m, [&](std::uint8_t a, std::uint8_t b) {
+            return key_age[a] != key_age[b] ? key_age[a] < key_age[b] : key_seq[a] > key_seq[b];
+        });
+        for (int j = 0; j < take; ++j) {
+            const int i = where[order[j]];
+            rows[i / w] |= static_cast<std::uint16_t>(1u << (i % w));
+        }
     }
     return scorer.score(rows);
 }
