@@ -9,7 +9,6 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -17,76 +16,53 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/efast.hpp"
 #include "evcorner/fa_harris.hpp"
+#include "detector_runs.hpp"
 #include "real_files.hpp"
 
-namespace fs = std::filesystem;
 using namespace evcorner;
 
 namespace {
 
-struct Input {
-    std::string name;
-    std::vector<Event> events;
-};
+// The 8 cuts with Arc* goldens: no slider_depth, no AEDAT recording.
+bool arcstar_cut(const bench::RealFile& f) { return f.ecd && f.name != "slider_depth"; }
 
-std::vector<Input> load_inputs() {
-    std::vector<Input> inputs;
-    for (const auto& f : bench::real_240x180_files(fs::path(EVCORNER_SHARED_DIR) / "data"))
-        if (f.ecd && f.name != "slider_depth") inputs.push_back({f.name, bench::load_events(f.events)});
-    if (inputs.empty())
-        inputs.push_back({"bundled_shapes_translation",
-                          bench::load_events(fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt")});
-    return inputs;
-}
-
-template <class Make, class Run>
-void run(benchmark::State& state, const Input* in, Make make, Run detect_with) {
+// Arc*'s portable loop (every x86-64 runs it), timed as bench::replay times detect().
+void replay_portable(benchmark::State& state, const bench::Input* in) {
     std::vector<std::uint8_t> flags(in->events.size());
     std::size_t corners = 0;
     for (auto _ : state) {
         state.PauseTiming();
-        auto det = make();
+        ArcStar det(kDavis240);
         state.ResumeTiming();
-        corners = detect_with(det, in->events, flags);
+        corners = det.run_unchecked<ScalarSearch>(in->events, flags);
         benchmark::DoNotOptimize(corners);
     }
-    const double n = static_cast<double>(in->events.size());
-    state.counters["time_per_event"] = benchmark::Counter(
-        n * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-    state.counters["corners"] = static_cast<double>(corners);
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * in->events.size()));
+    bench::per_event(state, in->events.size(), corners);
 }
-
-const auto kDetect = [](auto& det, const std::vector<Event>& ev, std::vector<std::uint8_t>& flags) {
-    return detect(det, std::span<const Event>(ev), flags);
-};
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    static const std::vector<Input> inputs = load_inputs();
-    for (const Input& in : inputs) {
-        const Input* p = &in;
+    static const std::vector<bench::Input> inputs = bench::load_real_inputs(arcstar_cut);
+    for (const bench::Input& in : inputs) {
+        const bench::Input* p = &in;
         benchmark::RegisterBenchmark(("efast/" + in.name).c_str(), [p](benchmark::State& s) {
-            run(s, p, [] { return EFast(kDavis240); }, kDetect);
+            bench::replay<true>(s, p, [] { return EFast(kDavis240); });
         })->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("arcstar/" + in.name).c_str(), [p](benchmark::State& s) {
-            run(s, p, [] { return ArcStar(kDavis240); }, kDetect);
+            bench::replay<true>(s, p, [] { return ArcStar(kDavis240); });
         })->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("arcstar_portable/" + in.name).c_str(), [p](benchmark::State& s) {
-            run(s, p, [] { return ArcStar(kDavis240); },
-                [](ArcStar& det, const std::vector<Event>& ev, std::vector<std::uint8_t>& flags) {
-                    return det.run_unchecked<ScalarSearch>(ev, flags);
-                });
+            replay_portable(s, p);
         })->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("arcstar_nofilter/" + in.name).c_str(), [p](benchmark::State& s) {
-            run(s, p, [] { return ArcStar(kDavis240, {.filter = false}); }, kDetect);
+            bench::replay<true>(s, p, [] { return ArcStar(kDavis240, {.filter = false}); });
         })->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("arcstar_minority/" + in.name).c_str(), [p](benchmark::State& s) {
-            run(s, p, [] { return ArcStar(kDavis240, {.minority_only = true}); }, kDetect);
+            bench::replay<true>(s, p, [] { return ArcStar(kDavis240, {.minority_only = true}); });
         })->Unit(benchmark::kMillisecond);
         benchmark::RegisterBenchmark(("fa_harris/" + in.name).c_str(), [p](benchmark::State& s) {
-            run(s, p, [] { return FaHarris(kDavis240); }, kDetect);
+            bench::replay<true>(s, p, [] { return FaHarris(kDavis240); });
         })->Unit(benchmark::kMillisecond);
     }
     benchmark::Initialize(&argc, argv);

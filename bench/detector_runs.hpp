@@ -22,12 +22,13 @@ struct Input {
     std::vector<Event> events;
 };
 
-/// The 11 real 240x180 files (real_files.hpp), else the bundled shapes_translation sample.
-inline std::vector<Input> load_real_inputs() {
+/// The 11 real 240x180 files (real_files.hpp), or those of them `keep` accepts, else the
+/// bundled shapes_translation sample.
+inline std::vector<Input> load_real_inputs(bool (*keep)(const RealFile&) = nullptr) {
     namespace fs = std::filesystem;
     std::vector<Input> inputs;
     for (const auto& f : real_240x180_files(fs::path(EVCORNER_SHARED_DIR) / "data"))
-        inputs.push_back({f.name, load_events(f.events)});
+        if (keep == nullptr || keep(f)) inputs.push_back({f.name, load_events(f.events)});
     if (inputs.empty())
         inputs.push_back({"bundled_shapes_translation",
                           load_events(fs::path(EVCORNER_SOURCE_DIR) / "data/ecd/shapes_translation/events.txt")});

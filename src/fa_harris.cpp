@@ -10,11 +10,14 @@
 
 #include "evcorner/circle.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace evcorner {
 
 namespace {
 
-constexpr int kBuckets = 65;  // bit width of an age: 0..64
 
 const FaHarrisParams& validated(const FaHarrisParams& p) {
     if (p.filter_us < 0 || p.filter_us > ArcStar::kMaxFilterUs)
@@ -80,76 +83,150 @@ bool FaHarris::process_with(const Event& e) noexcept {
     return score_ > params_.threshold;  // false for NaN
 }
 
-// The nl newest filtered pixels of the window, without sorting: bucket every cell by
-// the bit width of its age newest_ - t (octaves, monotone in age; a never-fired cell,
-// stored 0, lands in the oldest bucket of all), find the bucket where the count of newer
-// cells reaches nl, light every cell of the newer buckets and rank the few cells of that
-// boundary bucket exactly by (time, arrival).
-double FaHarris::refine(int p, int x, int y) const noexcept {
-    const int w = params_.window;
-    const int nl = params_.nl;
-    const int r = w / 2;
-    const std::size_t first = plane(p) + index(x - r, y - r);
-    const std::int64_t* const times = sae_.data() + first;
-    const std::uint64_t* const seqs = arrival_.data() + first;
-    std::uint8_t bucket[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
-    std::uint8_t histogram[4][kBuckets] = {};
+namespace {
+
+// Boundary cells up to this many are ranked by all pairs, more by std::nth_element.
+constexpr int kPairwiseMax = 16;
+
+// The nl newest filtered pixels of the window, without sorting. Every cell gets a byte
+// code monotone in its age newest - t: the exponent and the three top mantissa bits of
+// the age as a double (eighths of octaves up to 35 minutes, then one code for all older
+// cells and the never-fired ones, stored 0, which are older than every fired one;
+// rounding keeps the order, and ties within a code are resolved exactly below). The
+// boundary code, the first where the count of cells at least as new reaches nl, is found
+// by a binary search over the 256 codes, each step one branch-free count over the window
+// (vectorised). Every cell of a newer code is lit; of the m cells (a few) of the boundary
+// code the `take` newest are lit, ranked exactly by (age, later arrival first) with
+// branch-free comparisons of all pairs (a sort's branches mispredicted on every
+// candidate); only for many cells of one code (equal times), a partition.
+// W: the window side, 0 = the `window` given.
+template <int W>
+double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, std::size_t stride,
+                          std::int64_t newest, int window, int nl, const HarrisScorer& scorer) noexcept {
+    const int w = W != 0 ? W : window;
+    constexpr int kSide = W != 0 ? W : HarrisScorer::kMaxWindow;
+    constexpr int kCells = (kSide * kSide + 15) / 16 * 16;
+    const int n = w * w;
+    std::uint64_t age[kCells];
+    alignas(16) std::uint8_t code[kCells];
     int fired = 0;
     for (int row = 0, i = 0; row < w; ++row)
         for (int c = 0; c < w; ++c, ++i) {
-            const std::int64_t t = times[static_cast<std::size_t>(row) * stride_ + static_cast<std::size_t>(c)];
-            const auto b = static_cast<std::uint8_t>(
-                std::bit_width(static_cast<std::uint64_t>(newest_) - static_cast<std::uint64_t>(t)));
-            bucket[i] = b;
-            ++histogram[i & 3][b];
+            const std::int64_t t = times[static_cast<std::size_t>(row) * stride + static_cast<std::size_t>(c)];
+            const std::uint64_t a = static_cast<std::uint64_t>(newest) - static_cast<std::uint64_t>(t);
+            age[i] = a;
+            // Fired cells have ages below 2^63 and never-fired ones `newest` < 2^63, so the
+            // signed conversion keeps the order. The double's exponent and three top mantissa
+            // bits, (bits >> 49) - 8183, are 1..248 for ages 1..2^31 - 1 us; older ages share
+            // 255 with the never-fired cells, age 0 is 0.
+            const auto bits = std::bit_cast<std::uint64_t>(static_cast<double>(static_cast<std::int64_t>(a)));
+            code[i] = static_cast<std::uint8_t>(std::clamp(static_cast<int>(bits >> 49) - 8183, 0, 255));
             fired += t != 0;
         }
     if (fired < nl) return kNoScore;
+    for (int i = n; i < kCells; ++i) code[i] = 255;  // padding: counted as oldest, never lit, never a boundary cell
 
-    int boundary = 0, newer = 0;  // newer: cells in buckets below `boundary`
-    for (;;) {
-        const int here =
-            histogram[0][boundary] + histogram[1][boundary] + histogram[2][boundary] + histogram[3][boundary];
-        if (newer + here >= nl) break;
-        newer += here;
-        ++boundary;
-    }
+    const auto at_most = [&](int b) noexcept {  // cells with code <= b (padding included at 255)
+        int count = 0;
+        for (int i = 0; i < kCells; ++i) count += code[i] <= b;
+        return count;
+    };
+    // The smallest boundary in 0..255 with at_most(boundary) >= nl (at_most(255) >= n >= nl).
+    int boundary = 0;
+    for (int half = 128; half > 0; half >>= 1) boundary += at_most(boundary + half - 1) < nl ? half : 0;
+
+    // Row masks of the newer codes and the list of the boundary code's cells.
     std::uint16_t rows[HarrisScorer::kMaxWindow];
-    // The boundary bucket's cells, by position (row << 4 | column), gathered in the same
-    // pass; their (time, arrival) keys are read afterwards for those few cells only.
-    std::uint8_t where[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
-    int m = 0;
+    std::uint8_t where[kCells];
+    int m = 0, newer = 0;
+#if defined(__SSE2__)
+    // One bit per cell, 16 cells per compare (codes biased to signed bytes).
+    std::uint64_t lit_bits[(kCells + 63) / 64] = {}, at_bits[(kCells + 63) / 64] = {};
+    const __m128i bias = _mm_set1_epi8(static_cast<char>(0x80));
+    const __m128i limit = _mm_set1_epi8(static_cast<char>(boundary ^ 0x80));
+    for (int i = 0; i < kCells; i += 16) {
+        const __m128i v = _mm_xor_si128(_mm_load_si128(reinterpret_cast<const __m128i*>(code + i)), bias);
+        const auto lt = static_cast<std::uint64_t>(_mm_movemask_epi8(_mm_cmplt_epi8(v, limit)));
+        const auto eq = static_cast<std::uint64_t>(_mm_movemask_epi8(_mm_cmpeq_epi8(v, limit)));
+        lit_bits[i >> 6] |= lt << (i & 63);
+        at_bits[i >> 6] |= eq << (i & 63);
+    }
+    const auto field = [](const std::uint64_t* b, int at, int len) noexcept {  // bits at..at+len-1
+        const std::uint64_t lo = b[at >> 6] >> (at & 63);
+        const std::uint64_t hi = (at & 63) + len > 64 ? b[(at >> 6) + 1] << (64 - (at & 63)) : 0;
+        return static_cast<unsigned>((lo | hi) & ((std::uint64_t{1} << len) - 1));
+    };
+    for (int row = 0; row < w; ++row) {
+        rows[row] = static_cast<std::uint16_t>(field(lit_bits, row * w, w));
+        newer += std::popcount(rows[row]);
+    }
+    for (int k = 0; k < (kCells + 63) / 64; ++k) {
+        const int inside = std::clamp(n - 64 * k, 0, 64);  // the padding (code 255) is no cell
+        if (inside < 64) at_bits[k] &= (std::uint64_t{1} << inside) - 1;
+    }
+    for (int k = 0; k < (kCells + 63) / 64; ++k)
+        for (std::uint64_t b = at_bits[k]; b != 0; b &= b - 1)
+            where[m++] = static_cast<std::uint8_t>(64 * k + std::countr_zero(b));
+#else
     for (int row = 0, i = 0; row < w; ++row) {
         unsigned lit = 0;
         for (int c = 0; c < w; ++c, ++i) {
-            lit |= static_cast<unsigned>(bucket[i] < boundary) << c;
-            where[m] = static_cast<std::uint8_t>(row << 4 | c);
-            m += bucket[i] == boundary;
+            lit |= static_cast<unsigned>(code[i] < boundary) << c;
+            where[m] = static_cast<std::uint8_t>(i);
+            m += code[i] == boundary;
         }
         rows[row] = static_cast<std::uint16_t>(lit);
+        newer += std::popcount(lit);
     }
-    struct Key {
-        std::int64_t t;
-        std::uint64_t q;
-        int row, col;
-    };
-    Key keys[HarrisScorer::kMaxWindow * HarrisScorer::kMaxWindow];
-    for (int j = 0; j < m; ++j) {
-        const int row = where[j] >> 4, col = where[j] & 15;
-        const std::size_t at = static_cast<std::size_t>(row) * stride_ + static_cast<std::size_t>(col);
-        keys[j] = {times[at], seqs[at], row, col};
-    }
-    // Light the `take` newest of the boundary bucket: newer = later time, or the same time
-    // and a later arrival (arrival numbers are unique among fired cells; never-fired cells,
-    // time 0 and arrival 0, are the oldest, and fired >= nl keeps them out).
+#endif
     const int take = nl - newer;  // 1..m
-    if (take < m) {
-        std::nth_element(keys, keys + (take - 1), keys + m, [](const Key& a, const Key& b) {
-            return a.t != b.t ? a.t > b.t : a.q > b.q;
-        });
+    if (take == m) {
+        for (int j = 0; j < m; ++j) rows[where[j] / w] |= static_cast<std::uint16_t>(1u << (where[j] % w));
+        return scorer.score(rows);
     }
-    for (int j = 0; j < take; ++j) rows[keys[j].row] |= static_cast<std::uint16_t>(1u << keys[j].col);
-    return scorer_.score(rows);
+    // Newer = a smaller age, or the same age and a later arrival (arrival numbers are unique
+    // among fired cells; never-fired cells, all age `newest`, arrival 0, are the oldest, and
+    // fired >= nl keeps them unlit). A cell is lit iff fewer than `take` cells are newer.
+    std::uint64_t key_age[kCells], key_seq[kCells];
+    for (int j = 0; j < m; ++j) {
+        const int i = where[j];
+        key_age[j] = age[i];
+        key_seq[j] = seqs[static_cast<std::size_t>(i / w) * stride + static_cast<std::size_t>(i % w)];
+    }
+    if (m <= kPairwiseMax) {
+        for (int j = 0; j < m; ++j) {
+            int ahead = 0;
+            for (int k = 0; k < m; ++k)
+                ahead += (key_age[k] < key_age[j]) | ((key_age[k] == key_age[j]) & (key_seq[k] > key_seq[j]));
+            const int i = where[j];
+            rows[i / w] |= static_cast<std::uint16_t>(static_cast<unsigned>(ahead < take) << (i % w));
+        }
+    } else {
+        // Many cells of one code (equal times: a busy recording's microseconds): all pairs
+        // would cost m^2, so select the `take` newest by partition instead.
+        std::uint8_t order[kCells];
+        for (int j = 0; j < m; ++j) order[j] = static_cast<std::uint8_t>(j);
+        std::nth_element(order, order + (take - 1), order + m, [&](std::uint8_t a, std::uint8_t b) {
+            return key_age[a] != key_age[b] ? key_age[a] < key_age[b] : key_seq[a] > key_seq[b];
+        });
+        for (int j = 0; j < take; ++j) {
+            const int i = where[order[j]];
+            rows[i / w] |= static_cast<std::uint16_t>(1u << (i % w));
+        }
+    }
+    return scorer.score(rows);
+}
+
+}  // namespace
+
+double FaHarris::refine(int p, int x, int y) const noexcept {
+    const int r = params_.window / 2;
+    const std::size_t first = plane(p) + index(x - r, y - r);
+    const std::int64_t* const times = sae_.data() + first;
+    const std::uint64_t* const seqs = arrival_.data() + first;
+    if (params_.window == 9)
+        return newest_patch_score<9>(times, seqs, stride_, newest_, 9, params_.nl, scorer_);
+    return newest_patch_score<0>(times, seqs, stride_, newest_, params_.window, params_.nl, scorer_);
 }
 
 bool FaHarris::process_unchecked(const Event& e) noexcept { return process_with<ScalarSearch>(e); }

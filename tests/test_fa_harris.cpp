@@ -40,6 +40,9 @@ const Variant kVariants[] = {
     {"window7_nl20", {.window = 7, .nl = 20}, 2000, 60000},
     {"window13_nl40_k06", {.filter = false, .window = 13, .nl = 40, .k = 0.06}, 3, 0},
     {"threshold0", {.filter = false, .threshold = 0.0}, 3, 0},
+    // The smallest and the largest window (the selection's bit masks span 1 and 4 words).
+    {"window5_nl9", {.window = 5, .nl = 9, .threshold = -1.0e6}, 2000, 60000},
+    {"window15_nl30", {.filter = false, .window = 15, .nl = 30, .threshold = -1.0e6}, 3, 0},
 };
 
 class FaHarrisVsOracle : public ::testing::TestWithParam<SensorSize> {};
