@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -69,6 +70,30 @@ TEST_F(CliBench, ReportsColdAndReplayedFigures) {
         EXPECT_GT(x["cold_corners"].get<std::uint64_t>(), 0u);
         EXPECT_LT(x["cold_corners"].get<std::uint64_t>(), x["corners"].get<std::uint64_t>());
     }
+}
+
+TEST_F(CliBench, ReplayGapSeparatesCopiesByMoreThanTheFilterWindow) {
+    // By default each replayed copy starts 100 ms after the previous one ends, so Arc*'s 50 ms
+    // filter meets every copy as it meets the file's start; back to back (--replay-gap 0) the
+    // sample (46 ms long) repeats within 50 ms at every pixel it touches, and the filter
+    // rejects events the gap lets through. eFAST has no time window: the gap only
+    // shifts time, so its corners stay the same.
+    auto corners = [&](const std::string& extra, const std::string& json) {
+        const Result r = run("bench '" + sample_.string() + "' -d efast,arcstar --min-events 90000 --repeat 1 "
+                             "--no-latency -q --json " + json + extra);
+        EXPECT_EQ(r.status, 0) << r.err;
+        const auto j = nlohmann::json::parse(slurp(dir_ / json));
+        std::map<std::string, std::uint64_t> c;
+        for (const auto& x : j["results"]) c[x["detector"].get<std::string>()] = x["corners"].get<std::uint64_t>();
+        c["gap"] = j["replay_gap_us"].get<std::uint64_t>();
+        return c;
+    };
+    const auto gap = corners("", "gap.json");
+    const auto none = corners(" --replay-gap 0", "none.json");
+    EXPECT_EQ(gap.at("gap"), 100000u);
+    EXPECT_EQ(none.at("gap"), 0u);
+    EXPECT_EQ(gap.at("efast"), none.at("efast"));
+    EXPECT_GT(gap.at("arcstar"), none.at("arcstar"));
 }
 
 TEST_F(CliBench, YardstickIsAPlainEfastTimedInTheSameRun) {
