@@ -89,14 +89,23 @@ inline ArcExtent efast_arc_extent_doubled(const std::int64_t* d, int k, std::int
     return {};
 }
 
+// The circle t[0..N) twice into d[0..2N) (no modulo along an arc); returns the index of
+// its first newest pixel. (Both arc extents below start from it.)
+template <int N>
+inline int doubled_circle(const std::int64_t* t, std::int64_t* d) noexcept {
+    int k = 0;
+    for (int i = 0; i < N; ++i) {
+        d[i] = d[i + N] = t[i];
+        if (t[i] > t[k]) k = i;
+    }
+    return k;
+}
+
 // The same on one circle t[0..N).
 template <int N, int Lmin, int Lmax>
 inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
     std::int64_t d[2 * N];
-    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
-    int k = 0;
-    for (int i = 1; i < N; ++i)
-        if (t[i] > t[k]) k = i;
+    const int k = doubled_circle<N>(t, d);
     return efast_arc_extent_doubled<N, Lmin, Lmax>(d, k, now);
 }
 
@@ -106,10 +115,7 @@ inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexc
 template <int N, int Lmin>
 inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
     std::int64_t d[2 * N];
-    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
-    int k = 0;
-    for (int i = 1; i < N; ++i)
-        if (t[i] > t[k]) k = i;
+    const int k = doubled_circle<N>(t, d);
     std::int64_t joined[N];  // joined[i]: the time of the i-th pixel to join
     joined[0] = t[k];
     // The clockwise frontier d[cw] moves up from k + 1, the counter-clockwise one d[ccw]
