@@ -179,14 +179,14 @@ inline int gather_doubled(const std::int64_t* centre, std::ptrdiff_t width, cons
 }
 
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-// eFAST's arc test and score together on the AVX-512 path (Avx512Search, arc_test.hpp):
-// the binary test there computes, for every arc length L in range and every start s, whether
-// the arc t[s .. s+L-1] fires (its oldest newer than the rest's newest), and keeps only
-// "any". Kept per length as bit masks instead, they give the score without a second look at
-// the SAE: L = the shortest length whose mask is not empty (the definition's shortest firing
-// arc), s = its one start (the L newest pixels are one set, so one arc), and the arc's
-// oldest and the rest's newest are masked reductions over the circle already in registers.
-// Only for code compiled for AVX-512 (the scored AVX-512 loop of efast.cpp).
+// eFAST's score on the AVX-512 path (Avx512Search, arc_test.hpp), for a corner only: the
+// binary test computes, for every arc length L in range and every start s, whether the arc
+// t[s .. s+L-1] fires (its oldest newer than the rest's newest), and keeps only "any". Run
+// again keeping one bit mask per length, it gives the score with the circle in registers
+// (no gather into memory, no data-dependent branch): L = the shortest length whose mask is
+// not empty (the definition's shortest firing arc), s = its one start (the L newest pixels
+// are one set, so one arc), and the arc's oldest and the rest's newest are masked
+// reductions. Only for code compiled for AVX-512 (the scored AVX-512 loop of efast.cpp).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #if !defined(__clang__)
