@@ -93,7 +93,7 @@ public:
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return cells_.size() * sizeof(std::int64_t); }
 
 private:
-    // Offset of e's polarity plane in times_ and scores_.
+    // Offset of e's polarity plane within each half of cells_.
     [[nodiscard]] std::size_t plane_of(const Event& e) const noexcept {
         return static_cast<std::size_t>(planes_ == 2 && (e.p & 1)) * static_cast<std::size_t>(size_.pixels());
     }
