@@ -6,10 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "arcstar_test_streams.hpp"
@@ -118,6 +120,40 @@ TEST(Scores, EFastArcExtentIsTheDefinition) {
             expect_efast_extent_is_definition<16, 3, 6>(seed, distinct);
             expect_efast_extent_is_definition<20, 4, 8>(seed, distinct);
         }
+}
+
+// eFAST's score on the AVX-512 path (efast_score_avx512: the arc test's masks, masked
+// reductions) against the definition written plainly, bit for bit, on pairs of random
+// circles that both fire (ties, never-fired pixels). Skips where the CPU lacks AVX-512.
+TEST(Scores, EFastAvx512ScoreIsTheDefinition) {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    const auto paths = efast_code_paths();
+    if (std::find(paths.begin(), paths.end(), "avx512") == paths.end()) GTEST_SKIP() << "no AVX-512 on this CPU";
+    std::int64_t off3[16], off4[20];
+    for (int k = 0; k < 16; ++k) off3[k] = k;
+    for (int k = 0; k < 20; ++k) off4[k] = 16 + k;
+    for (std::uint64_t seed = 1; seed <= 3; ++seed)
+        for (const int distinct : {3, 8, 1000}) {
+            std::mt19937_64 rng(seed);
+            int compared = 0;
+            for (int trial = 0; trial < 20000; ++trial) {
+                const std::int64_t now = 1000 + static_cast<std::int64_t>(rng() % 100);
+                const auto c3 = random_circle<16>(rng, distinct, now);
+                const auto c4 = random_circle<20>(rng, distinct, now);
+                const auto want = naive::efast_score_naive(c3, c4, now);
+                if (!want) continue;  // not a corner: no score to compare
+                std::int64_t cells[36];
+                std::copy(c3.begin(), c3.end(), cells);
+                std::copy(c4.begin(), c4.end(), cells + 16);
+                ASSERT_EQ(efast_score_avx512(cells, off3, off4, now), *want)
+                    << "seed " << seed << " distinct " << distinct << " trial " << trial;
+                ++compared;
+            }
+            EXPECT_GT(compared, 100) << "too few corners to compare";
+        }
+#else
+    GTEST_SKIP() << "no AVX-512 code on this target";
+#endif
 }
 
 // Arc*'s fast arc extent (doubled circle, times recorded as they join) against its growth
@@ -277,10 +313,22 @@ const std::vector<std::string> kEdge = {
     "999999999",
 };
 
+// eFAST and Arc* (the two detectors whose scores are defined here, docs/scores.md) on the
+// same drawn grids: one typed test.
 template <class D>
-void expect_sharper_scores_higher(const char* name) {
+class DrawnGrids : public ::testing::Test {};
+struct DetectorName {
+    template <class D>
+    static std::string GetName(int) {
+        return std::is_same_v<D, EFast> ? "EFast" : "ArcStar";
+    }
+};
+using ArcDetectors = ::testing::Types<EFast, ArcStar>;
+TYPED_TEST_SUITE(DrawnGrids, ArcDetectors, DetectorName);
+
+TYPED_TEST(DrawnGrids, RankCornerLikeness) {
+    using D = TypeParam;
     const double sharp = score_of_grid<D>(kSharp), right = score_of_grid<D>(kRight), blunt = score_of_grid<D>(kBlunt);
-    SCOPED_TRACE(name);
     ASSERT_FALSE(std::isnan(sharp));
     ASSERT_FALSE(std::isnan(right));
     ASSERT_FALSE(std::isnan(blunt));
@@ -292,9 +340,6 @@ void expect_sharper_scores_higher(const char* name) {
     EXPECT_GT(right, recent) << "a larger timestamp margin ranks higher";
     EXPECT_TRUE(std::isnan(score_of_grid<D>(kEdge))) << "an edge is no corner and has no score";
 }
-
-TEST(Scores, EFastDrawnGridsRankCornerLikeness) { expect_sharper_scores_higher<EFast>("efast"); }
-TEST(Scores, ArcStarDrawnGridsRankCornerLikeness) { expect_sharper_scores_higher<ArcStar>("arcstar"); }
 
 TEST(Scores, EveryRegisteredDetectorHasAScore) {
     for (const DetectorInfo& d : detector_infos()) EXPECT_TRUE(d.has_score) << d.name;

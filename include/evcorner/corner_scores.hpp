@@ -19,8 +19,11 @@
 // size) for the final arc size of its growth (a majority arc's corner is its complement).
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
+#include <utility>
 
+#include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
 
 namespace evcorner {
@@ -86,14 +89,23 @@ inline ArcExtent efast_arc_extent_doubled(const std::int64_t* d, int k, std::int
     return {};
 }
 
+// The circle t[0..N) twice into d[0..2N) (no modulo along an arc); returns the index of
+// its first newest pixel. (Both arc extents below start from it.)
+template <int N>
+inline int doubled_circle(const std::int64_t* t, std::int64_t* d) noexcept {
+    int k = 0;
+    for (int i = 0; i < N; ++i) {
+        d[i] = d[i + N] = t[i];
+        if (t[i] > t[k]) k = i;
+    }
+    return k;
+}
+
 // The same on one circle t[0..N).
 template <int N, int Lmin, int Lmax>
 inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
     std::int64_t d[2 * N];
-    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
-    int k = 0;
-    for (int i = 1; i < N; ++i)
-        if (t[i] > t[k]) k = i;
+    const int k = doubled_circle<N>(t, d);
     return efast_arc_extent_doubled<N, Lmin, Lmax>(d, k, now);
 }
 
@@ -103,10 +115,7 @@ inline ArcExtent efast_arc_extent(const std::int64_t* t, std::int64_t now) noexc
 template <int N, int Lmin>
 inline ArcExtent arcstar_arc_extent(const std::int64_t* t, std::int64_t now) noexcept {
     std::int64_t d[2 * N];
-    for (int i = 0; i < N; ++i) d[i] = d[i + N] = t[i];
-    int k = 0;
-    for (int i = 1; i < N; ++i)
-        if (t[i] > t[k]) k = i;
+    const int k = doubled_circle<N>(t, d);
     std::int64_t joined[N];  // joined[i]: the time of the i-th pixel to join
     joined[0] = t[k];
     // The clockwise frontier d[cw] moves up from k + 1, the counter-clockwise one d[ccw]
@@ -169,6 +178,92 @@ inline int gather_doubled(const std::int64_t* centre, std::ptrdiff_t width, cons
     return k;
 }
 
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+// eFAST's score on the AVX-512 path (Avx512Search, arc_test.hpp), for a corner only: the
+// binary test computes, for every arc length L in range and every start s, whether the arc
+// t[s .. s+L-1] fires (its oldest newer than the rest's newest), and keeps only "any". Run
+// again keeping one bit mask per length, it gives the score with the circle in registers
+// (no gather into memory, no data-dependent branch): L = the shortest length whose mask is
+// not empty (the definition's shortest firing arc), s = its one start (the L newest pixels
+// are one set, so one arc), and the arc's oldest and the rest's newest are masked
+// reductions. Only for code compiled for AVX-512 (the scored AVX-512 loop of efast.cpp).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+struct Avx512Scored {
+    using C16 = Avx512Search::Circle16;
+    using C20 = Avx512Search::Circle20;
+    // Bit s of m[L - Lmin]: the arc of length L from pixel s fires.
+    template <int Lmin, int Lmax>
+    struct Masks {
+        unsigned m[Lmax - Lmin + 1];
+    };
+
+    // Bit k (k < N): a > b in lane k.
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline unsigned greater(const C16& a, const C16& b) noexcept {
+        return static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[0], b.v[0])) |
+               static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[1], b.v[1])) << 8;
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline unsigned greater(const C20& a, const C20& b) noexcept {
+        // Pixels 16..19 are the first four lanes of the third vector (its others repeat 0..3).
+        return static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[0], b.v[0])) |
+               static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[1], b.v[1])) << 8 |
+               (static_cast<unsigned>(_mm512_cmpgt_epi64_mask(a.v[2], b.v[2])) & 0xFu) << 16;
+    }
+
+    // Avx512Search::fires() keeping a mask per length: the same sliding minima and maxima.
+    template <int N, int Lmin, int Lmax, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline Masks<Lmin, Lmax> masks(const C& t) noexcept {
+        Masks<Lmin, Lmax> r;
+        [&]<int... I>(std::integer_sequence<int, I...>) {
+            ((r.m[I] = greater(Avx512Search::sliding<Lmin + I, false>(t),
+                               Avx512Search::sliding<N - Lmin - I, true>(t).template rot<Lmin + I>())),
+             ...);
+        }(std::make_integer_sequence<int, Lmax - Lmin + 1>{});
+        return r;
+    }
+
+    // The oldest (Max = false) or newest of the pixels whose bit is set in `in`.
+    template <bool Max>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline std::int64_t reduce(const C16& t, unsigned in) noexcept {
+        const __m512i fill = _mm512_set1_epi64(Max ? INT64_MIN : INT64_MAX);
+        const __m512i a = _mm512_mask_blend_epi64(static_cast<__mmask8>(in), fill, t.v[0]);
+        const __m512i b = _mm512_mask_blend_epi64(static_cast<__mmask8>(in >> 8), fill, t.v[1]);
+        return Max ? _mm512_reduce_max_epi64(_mm512_max_epi64(a, b)) : _mm512_reduce_min_epi64(_mm512_min_epi64(a, b));
+    }
+    template <bool Max>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline std::int64_t reduce(const C20& t, unsigned in) noexcept {
+        const __m512i fill = _mm512_set1_epi64(Max ? INT64_MIN : INT64_MAX);
+        const __m512i a = _mm512_mask_blend_epi64(static_cast<__mmask8>(in), fill, t.v[0]);
+        const __m512i b = _mm512_mask_blend_epi64(static_cast<__mmask8>(in >> 8), fill, t.v[1]);
+        const __m512i c = _mm512_mask_blend_epi64(static_cast<__mmask8>((in >> 16) & 0xFu), fill, t.v[2]);
+        return Max ? _mm512_reduce_max_epi64(_mm512_max_epi64(_mm512_max_epi64(a, b), c))
+                   : _mm512_reduce_min_epi64(_mm512_min_epi64(_mm512_min_epi64(a, b), c));
+    }
+
+    // The shortest firing arc of a corner's circle `t` (N pixels in registers): the shortest
+    // length whose mask has a bit, the one start s there (the L newest pixels are one set),
+    // the arc's oldest and the rest's newest by masked reductions. No data-dependent branch.
+    template <int N, int Lmin, int Lmax, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline ArcExtent extent(const C& t, std::int64_t now) noexcept {
+        const Masks<Lmin, Lmax> m = masks<N, Lmin, Lmax>(t);
+        unsigned lengths = 0;  // bit i: some arc of length Lmin + i fires
+        for (int i = 0; i <= Lmax - Lmin; ++i) lengths |= static_cast<unsigned>(m.m[i] != 0) << i;
+        if (lengths == 0) return {};  // not a corner (never for the events scored)
+        const int i = __builtin_ctz(lengths);
+        const int len = Lmin + i;
+        const int s = __builtin_ctz(m.m[i]);
+        constexpr unsigned kAll = (1u << N) - 1;
+        const unsigned run = (1u << len) - 1;
+        const unsigned arc = ((run << s) | (run >> (N - s))) & kAll;  // pixels s .. s+len-1 (mod N)
+        return {len, time_margin(reduce<false>(t, arc), reduce<true>(t, ~arc & kAll), now)};
+    }
+};
+#pragma GCC diagnostic pop
+#endif
+
 inline double combine(ArcExtent c3, ArcExtent c4) noexcept {
     return static_cast<double>((16 - c3.length) + (20 - c4.length) - 15) + std::min(c3.margin, c4.margin);
 }
@@ -183,6 +278,20 @@ inline double efast_score(const std::int64_t* centre, std::ptrdiff_t width, std:
     return detail::combine(detail::efast_arc_extent_doubled<16, 3, 6>(d3, k3, now),
                            detail::efast_arc_extent_doubled<20, 4, 8>(d4, k4, now));
 }
+
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+/// efast_score() on the AVX-512 path: the circles around `centre` (pixel k of each at
+/// centre[off3[k]], centre[off4[k]]) in registers, Avx512Search's arc test keeping its
+/// masks, the score from them. Only for code compiled for AVX-512.
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] inline double efast_score_avx512(const std::int64_t* centre,
+                                                                      const std::int64_t* off3,
+                                                                      const std::int64_t* off4,
+                                                                      std::int64_t now) noexcept {
+    using S = detail::Avx512Scored;
+    return detail::combine(S::extent<16, 3, 6>(Avx512Search::load16(centre, off3), now),
+                           S::extent<20, 4, 8>(Avx512Search::load20(centre, off4), now));
+}
+#endif
 
 /// Arc*'s score of a corner event whose filtered-SAE cell is `centre`, at stored time `now`.
 inline double arcstar_score(const std::int64_t* centre, std::ptrdiff_t width, std::int64_t now) noexcept {

@@ -111,8 +111,13 @@ public:
             const bool c = v.template process<Search>(e);
             is_corner[i] = static_cast<std::uint8_t>(c);
             corners += c;
-            if (c) [[unlikely]]
-                score[i] = v.score(e);
+            if (c) [[unlikely]] {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+                if constexpr (std::is_same_v<Search, Avx512Search>) score[i] = v.score_avx512(e);
+                else
+#endif
+                    score[i] = v.score(e);
+            }
         }
         return corners;
     }
@@ -171,11 +176,20 @@ private:
             }
         }
 
-        // The score of a corner event `e` from the SAE just updated with it.
+        // The score of a corner event `e` from the SAE just updated with it (out of line:
+        // the per-event path stays the binary one's).
         [[gnu::noinline]] double score(const Event& e) const noexcept {
             return efast_score(plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x, width,
                                Sae::stored(e.t));
         }
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        // The same on the AVX-512 path: the circles loaded into registers as its arc test
+        // loads them, the test's masks kept, the score from them (corner_scores.hpp).
+        [[gnu::noinline, gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] double score_avx512(const Event& e) const noexcept {
+            return efast_score_avx512(plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x, off3, off4,
+                                      Sae::stored(e.t));
+        }
+#endif
 
         // process() and, for a corner, its score.
         template <class Search>

@@ -75,7 +75,7 @@ public:
 
     [[nodiscard]] static std::uint64_t state_bytes(SensorSize size, int planes = 2) noexcept {
         return static_cast<std::uint64_t>(planes == 1 ? 1 : 2) * static_cast<std::uint64_t>(size.pixels()) *
-               sizeof(Cell);
+               (sizeof(std::int64_t) + sizeof(double));
     }
 
     /// Decides corner event `e` (on the sensor, p 0/1) of score `score`, and records it.
@@ -86,19 +86,29 @@ public:
     std::size_t filter(std::span<const Event> events, std::span<std::uint8_t> is_corner,
                        std::span<const double> score) noexcept;
 
+    /// Brings the cells keep(e, ...) reads into the cache (a hint, no effect on decisions).
+    void prefetch(const Event& e) const noexcept;
+
     [[nodiscard]] const NmsParams& params() const noexcept { return params_; }
-    [[nodiscard]] std::size_t memory_bytes() const noexcept { return cells_.size() * sizeof(Cell); }
+    [[nodiscard]] std::size_t memory_bytes() const noexcept { return cells_.size() * sizeof(std::int64_t); }
 
 private:
-    struct Cell {
-        std::int64_t t;  ///< time + 2^62 of the latest corner here; 0 = none (zero pages)
-        double score;
-    };
+    // Offset of e's polarity plane within each half of cells_.
+    [[nodiscard]] std::size_t plane_of(const Event& e) const noexcept {
+        return static_cast<std::size_t>(planes_ == 2 && (e.p & 1)) * static_cast<std::size_t>(size_.pixels());
+    }
     NmsParams params_;
     SensorSize size_;
     int planes_;
     double inv_time_;
-    ZeroedArray<Cell> cells_;
+    // Per pixel (and plane) the latest corner: its time + 2^62 (0 = none: zero pages) in
+    // the first half, its score's bits in the second: separate, so that a look at the
+    // neighbourhood reads the times first and the scores only of rows with a corner recent
+    // enough to matter. One allocation (as one plane of pairs was: the same memory).
+    ZeroedArray<std::int64_t> cells_;
+    [[nodiscard]] std::int64_t* times(const Event& e) noexcept { return cells_.data() + plane_of(e); }
+    [[nodiscard]] const std::int64_t* times(const Event& e) const noexcept { return cells_.data() + plane_of(e); }
+    [[nodiscard]] std::int64_t* score_bits(const Event& e) noexcept { return cells_.data() + cells_.size() / 2 + plane_of(e); }
 };
 
 /// A scored detector followed by AsyncNms: a detector whose corners are the kept ones.
