@@ -759,7 +759,7 @@ void run_eval(EvalOptions& o) {
             nlohmann::json jtruth;
             if (!matched.empty()) {
                 TruthRow tr{seq.name, k.name, n_events, corners.size(), labels.labelled, r.detect_s,
-                            std::move(matched[static_cast<std::size_t>(&k - kinds.data())]), {}};
+                            std::move(matched[static_cast<std::size_t>(&k - kinds.data())]), {}, {}};
                 tr.err = eval::summarize_errors(tr.m.errors);
                 if (k.scored) {
                     tr.pr = eval::pr_curve(k.scores, tr.m.is_true, tr.m.recalled_best, tr.m.truth_samples);
