@@ -9,6 +9,7 @@
 #include <string>
 
 #include "evcorner/circle.hpp"
+#include "evcorner/harris_select.hpp"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -87,6 +88,14 @@ namespace {
 
 // Boundary cells up to this many are ranked by all pairs, more by std::nth_element.
 constexpr int kPairwiseMax = 16;
+
+// The 9x9 score in AVX2 (bit-identical to the portable one) where adaptive Harris takes it:
+// its vector selection paths (harris_default_path(), which also honours EVCORNER_HARRIS_PATH;
+// asked on first use, not at static initialisation, where the CPU checks may not be ready).
+double patch_score(const HarrisScorer& scorer, int w, const std::uint16_t* rows) noexcept {
+    static const bool avx2 = harris_default_path() != HarrisPath::portable;
+    return avx2 && w == 9 ? scorer.score9_avx2(rows) : scorer.score(rows);
+}
 
 // The nl newest filtered pixels of the window, without sorting. Every cell gets a byte
 // code monotone in its age newest - t: the exponent and the three top mantissa bits of
@@ -182,7 +191,7 @@ double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, 
     const int take = nl - newer;  // 1..m
     if (take == m) {
         for (int j = 0; j < m; ++j) rows[where[j] / w] |= static_cast<std::uint16_t>(1u << (where[j] % w));
-        return scorer.score(rows);
+        return patch_score(scorer, w, rows);
     }
     // Newer = a smaller age, or the same age and a later arrival (arrival numbers are unique
     // among fired cells; never-fired cells, all age `newest`, arrival 0, are the oldest, and
@@ -214,7 +223,7 @@ double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, 
             rows[i / w] |= static_cast<std::uint16_t>(1u << (i % w));
         }
     }
-    return scorer.score(rows);
+    return patch_score(scorer, w, rows);
 }
 
 }  // namespace
