@@ -110,23 +110,6 @@ void check_nms_params(const NmsParams& p) {
 // The per-path bodies: keep() and filter() with one path's window test inlined (each
 // compiled for its path's instruction set below).
 struct NmsPath {
-    // Brings the cells keep(e) reads into the cache: the two ends of each row of the
-    // times (a row of up to 2 radius + 1 <= 31 cells spans at most 5 lines: the middle
-    // ones of a wide window are left to the hardware), and e's own score. Addresses off
-    // the sensor are formed as integers, never dereferenced (a prefetch does not fault).
-    [[gnu::always_inline]] static inline void prefetch(const AsyncNms& n, const Event& e) noexcept {
-        const std::uintptr_t W = static_cast<std::uintptr_t>(n.size_.width) * sizeof(std::int64_t);
-        const std::uintptr_t r = static_cast<std::uintptr_t>(n.params_.radius);
-        const std::uintptr_t centre = reinterpret_cast<std::uintptr_t>(n.times(e)) +
-                                      (static_cast<std::uintptr_t>(e.y) * n.size_.width + e.x) * sizeof(std::int64_t);
-        std::uintptr_t row = centre - r * W;
-        for (std::uintptr_t y = 0; y <= 2 * r; ++y, row += W) {
-            __builtin_prefetch(reinterpret_cast<const void*>(row - r * sizeof(std::int64_t)), 1);
-            __builtin_prefetch(reinterpret_cast<const void*>(row + r * sizeof(std::int64_t)), 1);
-        }
-        __builtin_prefetch(reinterpret_cast<const void*>(centre + n.cells_.size() / 2 * sizeof(std::int64_t)), 1);
-    }
-
     template <WindowFn Test>
     [[gnu::always_inline]] static inline bool keep(AsyncNms& n, const Event& e, double score) noexcept {
         const double s = std::isnan(score) ? -std::numeric_limits<double>::infinity() : score;
@@ -182,43 +165,30 @@ struct NmsPath {
     [[gnu::always_inline]] static inline std::size_t filter(AsyncNms& n, std::span<const Event> events,
                                                             std::span<std::uint8_t> is_corner,
                                                             std::span<const double> score) noexcept {
-        // A block of events at a time: first the positions of its corners (eight flags at a
-        // time: corners are rare), then the decisions, in event order, each made while the
-        // neighbourhoods of the corners kAhead further on are prefetched (scattered over
-        // the sensor and often cold, they would otherwise cost one memory latency after
-        // another). Only flags are read ahead; no decision depends on the order of loads.
-        constexpr std::size_t kBlock = 1024;
-        constexpr std::size_t kAhead = 4;
-        std::uint16_t at[kBlock];
+        // The corners in event order, found eight flags at a time (corners are rare).
+        // (Prefetching the neighbourhoods of the next corners was measured and bought
+        // nothing once the detector and the stage run a chunk at a time: nms.hpp.)
         std::size_t kept = 0;
-        for (std::size_t b = 0; b < events.size(); b += kBlock) {
-            const std::size_t end = std::min(events.size(), b + kBlock);
-            std::size_t m = 0, i = b;
-            for (; i + 8 <= end; i += 8) {
-                std::uint64_t w;
-                std::memcpy(&w, is_corner.data() + i, 8);
-                while (w != 0) {  // little-endian: the lowest byte is the first flag
-                    const int bit = std::countr_zero(w) & ~7;
-                    at[m++] = static_cast<std::uint16_t>(i - b + static_cast<std::size_t>(bit / 8));
-                    w &= ~(std::uint64_t{0xff} << bit);
-                }
-            }
-            for (; i < end; ++i)
-                if (is_corner[i] != 0) at[m++] = static_cast<std::uint16_t>(i - b);
-            for (std::size_t j = 0; j < std::min(m, kAhead); ++j) prefetch(n, events[b + at[j]]);
-            for (std::size_t j = 0; j < m; ++j) {
-                if (j + kAhead < m) prefetch(n, events[b + at[j + kAhead]]);
-                const std::size_t k = b + at[j];
-                const bool kp = keep<Test>(n, events[k], score[k]);
-                is_corner[k] = static_cast<std::uint8_t>(kp);
-                kept += kp;
+        const auto decide = [&](std::size_t k) {
+            const bool kp = keep<Test>(n, events[k], score[k]);
+            is_corner[k] = static_cast<std::uint8_t>(kp);
+            kept += kp;
+        };
+        std::size_t i = 0;
+        for (; i + 8 <= events.size(); i += 8) {
+            std::uint64_t w;
+            std::memcpy(&w, is_corner.data() + i, 8);
+            while (w != 0) {  // little-endian: the lowest byte is the first flag
+                const int bit = std::countr_zero(w) & ~7;
+                decide(i + static_cast<std::size_t>(bit / 8));
+                w &= ~(std::uint64_t{0xff} << bit);
             }
         }
+        for (; i < events.size(); ++i)
+            if (is_corner[i] != 0) decide(i);
         return kept;
     }
 };
-
-void AsyncNms::prefetch(const Event& e) const noexcept { NmsPath::prefetch(*this, e); }
 
 namespace {
 bool keep_portable(AsyncNms& n, const Event& e, double s) noexcept { return NmsPath::keep<window_portable>(n, e, s); }

@@ -89,9 +89,6 @@ public:
         return filter_(*this, events, is_corner, score);
     }
 
-    /// Brings the cells keep(e, ...) reads into the cache (a hint, no effect on decisions).
-    void prefetch(const Event& e) const noexcept;
-
     [[nodiscard]] const NmsParams& params() const noexcept { return params_; }
 
     /// The code paths of the window rule's neighbourhood test this CPU runs, fastest
