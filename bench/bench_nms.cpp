@@ -86,7 +86,8 @@ int once(const std::string& mode, const std::string& file, bool fingerprint) {
         mix(f[i]);
         if (f[i] && mode != "binary" && mode != "arc-binary") mix(std::bit_cast<std::uint64_t>(sc[i]));
     }
-    std::printf(", fingerprint %016llx (path %s)\n", static_cast<unsigned long long>(h), efast_code_path());
+    std::printf(", fingerprint %016llx (eFAST path %s, NMS path %s)\n", static_cast<unsigned long long>(h),
+                efast_code_path(), AsyncNms(kDavis240, NmsParams{}).code_path());
     return 0;
 }
 
@@ -163,9 +164,10 @@ int main(int argc, char** argv) {
     }
     (void)names;
     std::printf("median over files: scored/binary %.3f, nms-window/binary %.3f, nms-decay/binary %.3f, "
-                "nms-window/scored %.3f (ns/event medians of %d interleaved passes, %s; path %s)\n",
+                "nms-window/scored %.3f (ns/event medians of %d interleaved passes, %s; eFAST path %s, NMS path %s)\n",
                 median(ratio_scored), median(ratio_nms_w), median(ratio_nms_d), median(ratio_nms_w_scored), passes,
-                cpu_time ? "thread CPU time" : "wall clock", efast_code_path());
+                cpu_time ? "thread CPU time" : "wall clock", efast_code_path(),
+                AsyncNms(kDavis240, NmsParams{}).code_path());
     std::printf("scored flags identical to binary on every file: %s\n", same ? "yes" : "NO");
     return same ? 0 : 1;
 }

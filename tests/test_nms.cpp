@@ -122,16 +122,28 @@ TEST(Nms, ParametersChecked) {
     EXPECT_THROW(AsyncNms(kS, params(NmsRule::window, 2, 0)), std::invalid_argument);
     EXPECT_THROW(parse_nms_rule("max"), std::invalid_argument);
     EXPECT_EQ(parse_nms_rule("decay"), NmsRule::decay);
+    AsyncNms n(kS, params(NmsRule::window, 2));
+    EXPECT_THROW(n.use_code_path("sse9"), std::invalid_argument);
 }
 
 TEST(Nms, MatchesTheOracleOnRandomCornerStreams) {
+    // Every code path of the window test this CPU runs; radii whose rows fill a vector
+    // exactly, leave a remainder, or take several vectors (7 = 4 + 3, 15 = 8 + 7 cells).
+    const std::vector<std::string> paths = AsyncNms::code_paths();
+    ASSERT_FALSE(paths.empty());
+    EXPECT_EQ(paths.back(), "portable");
+    RecordProperty("nms_code_paths", static_cast<int>(paths.size()));
+    for (const std::string& path : paths)
     for (const NmsRule rule : {NmsRule::window, NmsRule::decay})
-        for (const int radius : {0, 1, 2, 4})
+        for (const int radius : {0, 1, 2, 3, 4, 7})
             for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-                SCOPED_TRACE(testing::Message() << nms_rule_name(rule) << " radius " << radius << " seed " << seed);
+                SCOPED_TRACE(testing::Message() << path << " " << nms_rule_name(rule) << " radius " << radius
+                                                << " seed " << seed);
                 std::mt19937_64 rng(seed);
                 const NmsParams p = params(rule, radius, 1 + static_cast<std::int64_t>(rng() % 300));
                 AsyncNms fast(kS, p);
+                fast.use_code_path(path);
+                EXPECT_STREQ(fast.code_path(), path.c_str());
                 naive::NmsNaive oracle(p);
                 std::int64_t t = static_cast<std::int64_t>(rng() % 1000) - 500;
                 std::size_t kept = 0, dropped = 0;
@@ -205,6 +217,57 @@ TEST(Nms, ThreadsIdenticalToOneThreadHarris) {
     const auto events = test::arcstar_stream(s, 40000, 9, 20, 10000);
     expect_threads_identical<Harris>(events, s, HarrisParams{}.window / 2, true,
                                      [](SensorSize z, int planes) { return Harris(z, {}, planes); });
+}
+
+// The batch loop of Suppressed<D> (the detector's loop and the stage's filter, a chunk of
+// kNmsChunk events at a time, corners gathered a block at a time and prefetched ahead)
+// decides as the stage does event by event, on every code path, in one call and in
+// batches of odd sizes that cut chunks anywhere; with and without the caller's scores.
+TEST(Nms, BatchLoopEqualsEventByEventOnEveryPath) {
+    const SensorSize s{240, 180};
+    const auto events = test::arcstar_stream(s, 3 * kNmsChunk + 777, 11, 20, 10000);
+    for (const NmsRule rule : {NmsRule::window, NmsRule::decay})
+        for (const int radius : {2, 5}) {
+            const NmsParams p = params(rule, radius, 3000);
+            Suppressed<EFast> one(EFast(s), p);
+            std::vector<std::uint8_t> want(events.size());
+            std::vector<double> want_score(events.size());
+            std::size_t kept = 0;
+            for (std::size_t i = 0; i < events.size(); ++i)
+                kept += want[i] = one.process_scored_unchecked(events[i], want_score[i]);
+            std::size_t raw = 0;
+            {
+                EFast plain(s);
+                std::vector<std::uint8_t> f(events.size());
+                raw = detect(plain, std::span<const Event>(events), f);
+            }
+            ASSERT_GT(kept, 0u);
+            ASSERT_LT(kept, raw) << "NMS suppressed nothing: the comparison is weak";
+            for (const std::string& path : AsyncNms::code_paths())
+                for (const std::size_t batch : {events.size(), std::size_t{1000}, std::size_t{4097}}) {
+                    SCOPED_TRACE(testing::Message() << path << " " << nms_rule_name(rule) << " radius " << radius
+                                                    << " batch " << batch);
+                    Suppressed<EFast> a(EFast(s), p), b(EFast(s), p);
+                    a.nms().use_code_path(path);
+                    b.nms().use_code_path(path);
+                    std::vector<std::uint8_t> fa(events.size()), fb(events.size());
+                    std::vector<double> sa(events.size());
+                    std::size_t ca = 0, cb = 0;
+                    for (std::size_t at = 0; at < events.size(); at += batch) {
+                        const std::size_t n = std::min(batch, events.size() - at);
+                        const auto ev = std::span<const Event>(events).subspan(at, n);
+                        ca += detect(a, ev, std::span<std::uint8_t>(fa).subspan(at, n), std::span<double>(sa).subspan(at, n));
+                        cb += detect(b, ev, std::span<std::uint8_t>(fb).subspan(at, n));
+                    }
+                    EXPECT_EQ(ca, kept);
+                    EXPECT_EQ(cb, kept);
+                    for (std::size_t i = 0; i < events.size(); ++i) {
+                        ASSERT_EQ(fa[i], want[i]) << "event " << i;
+                        ASSERT_EQ(fb[i], want[i]) << "event " << i;
+                        if (want[i]) ASSERT_EQ(sa[i], want_score[i]) << "event " << i;
+                    }
+                }
+        }
 }
 
 TEST(Nms, PipelineNmsEveryDetectorAndThreads) {

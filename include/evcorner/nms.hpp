@@ -27,6 +27,7 @@
 // Detector concept; scored too): the pipeline, --threads and the bindings run it as any
 // other. Its batch loop runs D's own scored batch loop, then the stage over the corners.
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -79,17 +80,25 @@ public:
     }
 
     /// Decides corner event `e` (on the sensor, p 0/1) of score `score`, and records it.
-    bool keep(const Event& e, double score) noexcept;
+    bool keep(const Event& e, double score) noexcept { return keep_(*this, e, score); }
 
     /// Runs keep() over the corners of a batch: is_corner[i] becomes 0 where events[i]
     /// is suppressed. Returns the corners kept.
     std::size_t filter(std::span<const Event> events, std::span<std::uint8_t> is_corner,
-                       std::span<const double> score) noexcept;
-
-    /// Brings the cells keep(e, ...) reads into the cache (a hint, no effect on decisions).
-    void prefetch(const Event& e) const noexcept;
+                       std::span<const double> score) noexcept {
+        return filter_(*this, events, is_corner, score);
+    }
 
     [[nodiscard]] const NmsParams& params() const noexcept { return params_; }
+
+    /// The code paths of the window rule's neighbourhood test this CPU runs, fastest
+    /// first ("avx512", "avx2", "portable"); all decide alike (tests hold each to the
+    /// oracle). A new stage takes the first, or the one EVCORNER_NMS_PATH names.
+    [[nodiscard]] static std::vector<std::string> code_paths();
+    /// This stage's path; use_code_path() switches it (std::invalid_argument for a path
+    /// this CPU does not run).
+    [[nodiscard]] const char* code_path() const noexcept { return path_name_; }
+    void use_code_path(std::string_view name);
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return cells_.size() * sizeof(std::int64_t); }
 
 private:
@@ -97,8 +106,17 @@ private:
     [[nodiscard]] std::size_t plane_of(const Event& e) const noexcept {
         return static_cast<std::size_t>(planes_ == 2 && (e.p & 1)) * static_cast<std::size_t>(size_.pixels());
     }
+    // The code path's compiled pair of calls (keep, filter), chosen at construction; the
+    // per-path bodies live in nms.cpp (struct NmsPath).
+    friend struct NmsPath;
+    using KeepFn = bool (*)(AsyncNms&, const Event&, double) noexcept;
+    using FilterFn = std::size_t (*)(AsyncNms&, std::span<const Event>, std::span<std::uint8_t>,
+                                     std::span<const double>) noexcept;
     NmsParams params_;
     SensorSize size_;
+    KeepFn keep_;
+    FilterFn filter_;
+    const char* path_name_;
     int planes_;
     double inv_time_;
     // Per pixel (and plane) the latest corner: its time + 2^62 (0 = none: zero pages) in
@@ -163,26 +181,43 @@ private:
 };
 
 /// The batch loops of Suppressed<D>: D's own scored batch loop (eFAST's fastest path, ...),
-/// then the stage over its corners.
+/// then the stage over its corners, a chunk of kNmsChunk events at a time: the stage reads
+/// each corner's event and score right after the detector wrote them, while they are in
+/// the cache (over a whole file at once they were not: on a 374 000-event recording reading
+/// them back cost as much as the suppression itself). Decisions do not depend on the chunk.
+inline constexpr std::size_t kNmsChunk = 4096;
 template <ScoredDetector D>
 std::size_t detect_unchecked(Suppressed<D>& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
                              std::span<double> score) noexcept {
-    detect_unchecked(det.detector(), events, is_corner, score);
-    return det.nms().filter(events, is_corner, score);
+    std::size_t kept = 0;
+    for (std::size_t at = 0; at < events.size(); at += kNmsChunk) {
+        const std::size_t n = std::min(kNmsChunk, events.size() - at);
+        const auto ev = events.subspan(at, n);
+        const auto flags = is_corner.subspan(at, n);
+        const auto sc = score.subspan(at, n);
+        detect_unchecked(det.detector(), ev, flags, sc);
+        kept += det.nms().filter(ev, flags, sc);
+    }
+    return kept;
 }
 template <ScoredDetector D>
 std::size_t detect_unchecked(Suppressed<D>& det, std::span<const Event> events,
                              std::span<std::uint8_t> is_corner) noexcept {
-    // The scratch buffer: allocation outside the per-event loop (a batch at a time).
+    // The scratch scores of a chunk: allocated once, outside the per-event loop.
     std::span<double> score;
     try {
-        score = det.scratch(events.size());
+        score = det.scratch(std::min(events.size(), kNmsChunk));
     } catch (...) {
         std::size_t corners = 0;  // no memory for a buffer: event by event
         for (std::size_t i = 0; i < events.size(); ++i) corners += (is_corner[i] = det.process_unchecked(events[i]));
         return corners;
     }
-    return detect_unchecked(det, events, is_corner, score);
+    std::size_t kept = 0;
+    for (std::size_t at = 0; at < events.size(); at += kNmsChunk) {
+        const std::size_t n = std::min(kNmsChunk, events.size() - at);
+        kept += detect_unchecked(det, events.subspan(at, n), is_corner.subspan(at, n), score.first(n));
+    }
+    return kept;
 }
 // The checked detect() of detector.hpp and scored_detector.hpp find these loops.
 
