@@ -108,23 +108,43 @@ template <int N, int Lmin, int Lmax>
             grid[static_cast<std::size_t>(centre + o.dy * kGrid + o.dx)] = c[k];
         }
         // The event's stored time: just after the newest pixel (32-bit relative times), or
-        // far away (some or all fired pixels beyond +-2^31: the portable fallback).
-        std::int64_t newest = 0;
-        for (std::int64_t v : c) newest = std::max(newest, v);
-        const std::int64_t st_near = newest + static_cast<std::int64_t>(rng() % 1000);
-        const std::int64_t st_far = (std::int64_t{1} << 31) + static_cast<std::int64_t>(rng() % 2000000);
+        // far away (some or all fired pixels beyond +-2^31: the portable fallback), or at
+        // the edge of the relative range: the oldest fired pixel 2^30 - 1 before the event
+        // (the last time held relative, one above the never-fired value -2^30) and 2^30
+        // before it (the first one that is not: the fallback).
+        std::int64_t newest = 0, oldest_fired = INT64_MAX;
+        for (std::int64_t v : c) {
+            newest = std::max(newest, v);
+            if (v != 0) oldest_fired = std::min(oldest_fired, v);
+        }
+        constexpr std::int64_t kRange = std::int64_t{1} << 30;
+        std::vector<std::int64_t> times = {newest + static_cast<std::int64_t>(rng() % 1000),
+                                           (std::int64_t{1} << 31) + static_cast<std::int64_t>(rng() % 2000000)};
+        if (oldest_fired != INT64_MAX) {
+            times.push_back(oldest_fired + kRange - 1);
+            times.push_back(oldest_fired + kRange);
+        }
+        // And the other edge, an event older than the pixels (unsorted input): the circle
+        // moved up by 2^31 (order unchanged), the newest pixel 2^30 - 1 after the event
+        // (relative) and 2^30 after it (the fallback).
+        std::array<std::int64_t, kGrid * kGrid> later = grid;
+        for (std::int64_t& v : later)
+            if (v != 0) v += std::int64_t{1} << 31;
+        const std::int64_t later_newest = newest + (std::int64_t{1} << 31);
+        const std::size_t n_grid = times.size();
+        if (newest != 0) {
+            times.push_back(later_newest - (kRange - 1));
+            times.push_back(later_newest - kRange);
+        }
         for (bool minority : {false, true}) {
             const bool want = naive::arcstar_arc_naive<N>(c, Lmin, Lmax, minority);
-            bool near, far;
-            if constexpr (N == 16) {
-                near = ArcStarAvx512::circle16_passes(grid.data() + centre, kGrid, st_near, minority);
-                far = ArcStarAvx512::circle16_passes(grid.data() + centre, kGrid, st_far, minority);
-            } else {
-                near = ArcStarAvx512::circle20_passes(grid.data() + centre, kGrid, st_near, minority);
-                far = ArcStarAvx512::circle20_passes(grid.data() + centre, kGrid, st_far, minority);
+            for (std::size_t j = 0; j < times.size(); ++j) {
+                const std::int64_t* const at = (j < n_grid ? grid.data() : later.data()) + centre;
+                bool got;
+                if constexpr (N == 16) got = ArcStarAvx512::circle16_passes(at, kGrid, times[j], minority);
+                else got = ArcStarAvx512::circle20_passes(at, kGrid, times[j], minority);
+                ASSERT_EQ(got, want) << "circle #" << i << ", event time #" << j;
             }
-            ASSERT_EQ(near, want) << "circle #" << i;
-            ASSERT_EQ(far, want) << "circle #" << i;
         }
     }
 }
