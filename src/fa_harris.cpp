@@ -98,7 +98,9 @@ double patch_score(const HarrisScorer& scorer, HarrisPath path, int w, const std
     return path != HarrisPath::portable && w == 9 ? scorer.score9_avx2(rows) : scorer.score(rows);
 }
 
-// The nl newest filtered pixels of the window, without sorting. Every cell gets a byte
+// For streams whose filtered writes went back in time (refine() takes harris_select.hpp's
+// selection on arrival numbers while they come in time order):
+// the nl newest filtered pixels of the window, without sorting. Every cell gets a byte
 // code monotone in its age newest - t: the exponent and the three top mantissa bits of
 // the age as a double (eighths of octaves up to 35 minutes, then one code for all older
 // cells and the never-fired ones, stored 0, which are older than every fired one;

@@ -46,6 +46,27 @@ const Variant kVariants[] = {
     {"window15_nl30", {.filter = false, .window = 15, .nl = 30, .threshold = -1.0e6}, 3, 0},
 };
 
+// Feeds `ev` to process(), to the batch detect() (the AVX2 loop where the CPU has it) and
+// to the oracle: the same corners and scores event for event. Adds the corners, and the
+// scored events from index `count_from` on.
+void compare_with_oracle(SensorSize s, const Variant& v, const std::vector<Event>& ev, std::uint64_t seed,
+                         std::size_t& corners, std::size_t& scored, std::size_t count_from = 0) {
+    FaHarris fast(s, v.params), batch(s, v.params);
+    naive::FaHarrisNaive oracle(s, v.params);
+    std::vector<std::uint8_t> flags(ev.size());
+    detect(batch, std::span<const Event>(ev), flags);
+    for (std::size_t i = 0; i < ev.size(); ++i) {
+        const bool want = oracle.process(ev[i]);
+        ASSERT_EQ(fast.process(ev[i]), want) << v.name << " seed " << seed << " event " << i;
+        ASSERT_EQ(flags[i] != 0, want) << v.name << " (detect) seed " << seed << " event " << i;
+        ASSERT_TRUE(same_score(fast.last_score(), oracle.last_score()))
+            << v.name << " seed " << seed << " event " << i << ": " << fast.last_score() << " vs "
+            << oracle.last_score();
+        corners += want;
+        scored += i >= count_from && !std::isnan(oracle.last_score());
+    }
+}
+
 class FaHarrisVsOracle : public ::testing::TestWithParam<SensorSize> {};
 
 TEST_P(FaHarrisVsOracle, SameCornersAndScoresEventForEvent) {
@@ -60,20 +81,7 @@ TEST_P(FaHarrisVsOracle, SameCornersAndScoresEventForEvent) {
         for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
             const auto ev = test::arcstar_stream(s, n, seed * 104729 + static_cast<std::uint64_t>(s.height), v.step_us,
                                                  v.pause_us);
-            FaHarris fast(s, v.params), batch(s, v.params);
-            naive::FaHarrisNaive oracle(s, v.params);
-            std::vector<std::uint8_t> flags(ev.size());
-            detect(batch, std::span<const Event>(ev), flags);  // the AVX2 loop where the CPU has it
-            for (std::size_t i = 0; i < ev.size(); ++i) {
-                const bool want = oracle.process(ev[i]);
-                ASSERT_EQ(fast.process(ev[i]), want) << v.name << " seed " << seed << " event " << i;
-                ASSERT_EQ(flags[i] != 0, want) << v.name << " (detect) seed " << seed << " event " << i;
-                ASSERT_TRUE(same_score(fast.last_score(), oracle.last_score()))
-                    << v.name << " seed " << seed << " event " << i << ": " << fast.last_score() << " vs "
-                    << oracle.last_score();
-                corners += want;
-                scored += !std::isnan(oracle.last_score());
-            }
+            ASSERT_NO_FATAL_FAILURE(compare_with_oracle(s, v, ev, seed, corners, scored));
             ++streams;
             events += ev.size();
         }
@@ -99,7 +107,7 @@ INSTANTIATE_TEST_SUITE_P(Sizes, FaHarrisVsOracle,
 // came in time order, and by (time, arrival) from the first one that did not; both halves
 // against the oracle, on a window of 9 (the vector selections) and of 7.
 TEST(FaHarrisOutOfOrder, TimesGoBackFromHalfWayAsTheOracle) {
-    std::size_t scored_after = 0, back = 0;
+    std::size_t corners = 0, scored_after = 0, back = 0;
     for (const SensorSize s : {SensorSize{240, 180}, SensorSize{17, 13}})
         for (const Variant& v : {kVariants[0], kVariants[1], kVariants[4]})
             for (std::uint64_t seed = 1; seed <= 2; ++seed) {
@@ -111,19 +119,7 @@ TEST(FaHarrisOutOfOrder, TimesGoBackFromHalfWayAsTheOracle) {
                         ev[i].t -= static_cast<std::int64_t>(rng() % 5001);
                         back += ev[i].t < ev[i - 1].t;
                     }
-                FaHarris fast(s, v.params), batch(s, v.params);
-                naive::FaHarrisNaive oracle(s, v.params);
-                std::vector<std::uint8_t> flags(ev.size());
-                detect(batch, std::span<const Event>(ev), flags);
-                for (std::size_t i = 0; i < ev.size(); ++i) {
-                    const bool want = oracle.process(ev[i]);
-                    ASSERT_EQ(fast.process(ev[i]), want) << v.name << " seed " << seed << " event " << i;
-                    ASSERT_EQ(flags[i] != 0, want) << v.name << " (detect) seed " << seed << " event " << i;
-                    ASSERT_TRUE(same_score(fast.last_score(), oracle.last_score()))
-                        << v.name << " seed " << seed << " event " << i << ": " << fast.last_score() << " vs "
-                        << oracle.last_score();
-                    scored_after += i >= ev.size() / 2 && !std::isnan(oracle.last_score());
-                }
+                ASSERT_NO_FATAL_FAILURE(compare_with_oracle(s, v, ev, seed, corners, scored_after, ev.size() / 2));
             }
     EXPECT_GT(back, 1000u);
     EXPECT_GT(scored_after, 100u);
