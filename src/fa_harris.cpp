@@ -46,7 +46,8 @@ FaHarris::FaHarris(SensorSize size, const Params& params, int /*planes*/)
       plane_size_(stride_ * (static_cast<std::size_t>(size_.height) + 2 * static_cast<std::size_t>(pad_))),
       latest_(static_cast<std::size_t>(size_.pixels())),
       sae_(2 * plane_size_),
-      arrival_(2 * plane_size_) {}
+      arrival_(2 * plane_size_),
+      path_(harris_default_path()) {}
 
 std::uint64_t FaHarris::state_bytes(SensorSize size, const Params& params, int) noexcept {
     const auto pad = static_cast<std::uint64_t>(frame(params.window));
@@ -73,6 +74,7 @@ bool FaHarris::process_with(const Event& e) noexcept {
     std::int64_t* const centre = sae_.data() + i;
     *centre = st;
     arrival_[i] = ++arrivals_;
+    in_time_order_ &= st >= newest_;
     newest_ = std::max(newest_, st);
     // (3) The Arc* candidate test (the AVX-512 path reads *centre as the event's time).
     if (!ArcStarCircles(static_cast<std::ptrdiff_t>(stride_))
@@ -89,15 +91,16 @@ namespace {
 // Boundary cells up to this many are ranked by all pairs, more by std::nth_element.
 constexpr int kPairwiseMax = 16;
 
-// The 9x9 score in AVX2 (bit-identical to the portable one) where adaptive Harris takes it:
-// its vector selection paths (harris_default_path(), which also honours EVCORNER_HARRIS_PATH;
-// asked on first use, not at static initialisation, where the CPU checks may not be ready).
-double patch_score(const HarrisScorer& scorer, int w, const std::uint16_t* rows) noexcept {
-    static const bool avx2 = harris_default_path() != HarrisPath::portable;
-    return avx2 && w == 9 ? scorer.score9_avx2(rows) : scorer.score(rows);
+// The 9x9 score in AVX2 (bit-identical to the portable one) with adaptive Harris's vector
+// selection paths, as Harris takes it (`path`: harris_default_path(), which honours
+// EVCORNER_HARRIS_PATH).
+double patch_score(const HarrisScorer& scorer, HarrisPath path, int w, const std::uint16_t* rows) noexcept {
+    return path != HarrisPath::portable && w == 9 ? scorer.score9_avx2(rows) : scorer.score(rows);
 }
 
-// The nl newest filtered pixels of the window, without sorting. Every cell gets a byte
+// For streams whose filtered writes went back in time (refine() takes harris_select.hpp's
+// selection on arrival numbers while they come in time order):
+// the nl newest filtered pixels of the window, without sorting. Every cell gets a byte
 // code monotone in its age newest - t: the exponent and the three top mantissa bits of
 // the age as a double (eighths of octaves up to 35 minutes, then one code for all older
 // cells and the never-fired ones, stored 0, which are older than every fired one;
@@ -111,7 +114,8 @@ double patch_score(const HarrisScorer& scorer, int w, const std::uint16_t* rows)
 // W: the window side, 0 = the `window` given.
 template <int W>
 double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, std::size_t stride,
-                          std::int64_t newest, int window, int nl, const HarrisScorer& scorer) noexcept {
+                          std::int64_t newest, int window, int nl, const HarrisScorer& scorer,
+                          HarrisPath path) noexcept {
     const int w = W != 0 ? W : window;
     constexpr int kSide = W != 0 ? W : HarrisScorer::kMaxWindow;
     constexpr int kCells = (kSide * kSide + 15) / 16 * 16;
@@ -191,7 +195,7 @@ double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, 
     const int take = nl - newer;  // 1..m
     if (take == m) {
         for (int j = 0; j < m; ++j) rows[where[j] / w] |= static_cast<std::uint16_t>(1u << (where[j] % w));
-        return patch_score(scorer, w, rows);
+        return patch_score(scorer, path, w, rows);
     }
     // Newer = a smaller age, or the same age and a later arrival (arrival numbers are unique
     // among fired cells; never-fired cells, all age `newest`, arrival 0, are the oldest, and
@@ -223,7 +227,7 @@ double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, 
             rows[i / w] |= static_cast<std::uint16_t>(1u << (i % w));
         }
     }
-    return patch_score(scorer, w, rows);
+    return patch_score(scorer, path, w, rows);
 }
 
 }  // namespace
@@ -231,11 +235,20 @@ double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, 
 double FaHarris::refine(int p, int x, int y) const noexcept {
     const int r = params_.window / 2;
     const std::size_t first = plane(p) + index(x - r, y - r);
-    const std::int64_t* const times = sae_.data() + first;
     const std::uint64_t* const seqs = arrival_.data() + first;
+    if (in_time_order_) {
+        // Every filtered write came in time order, so a later arrival number is a later
+        // time or the same time and a later arrival: the nl newest are the nl largest
+        // arrival numbers (0 = never passed), as adaptive Harris selects them.
+        std::uint16_t rows[HarrisScorer::kMaxWindow];
+        if (!harris_select_newest(path_, seqs, stride_, params_.window, arrivals_, params_.nl, rows))
+            return kNoScore;  // fewer than nl filtered pixels in the window
+        return patch_score(scorer_, path_, params_.window, rows);
+    }
+    const std::int64_t* const times = sae_.data() + first;
     if (params_.window == 9)
-        return newest_patch_score<9>(times, seqs, stride_, newest_, 9, params_.nl, scorer_);
-    return newest_patch_score<0>(times, seqs, stride_, newest_, params_.window, params_.nl, scorer_);
+        return newest_patch_score<9>(times, seqs, stride_, newest_, 9, params_.nl, scorer_, path_);
+    return newest_patch_score<0>(times, seqs, stride_, newest_, params_.window, params_.nl, scorer_, path_);
 }
 
 bool FaHarris::process_unchecked(const Event& e) noexcept { return process_with<ScalarSearch>(e); }

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -45,6 +46,27 @@ const Variant kVariants[] = {
     {"window15_nl30", {.filter = false, .window = 15, .nl = 30, .threshold = -1.0e6}, 3, 0},
 };
 
+// Feeds `ev` to process(), to the batch detect() (the AVX2 loop where the CPU has it) and
+// to the oracle: the same corners and scores event for event. Adds the corners, and the
+// scored events from index `count_from` on.
+void compare_with_oracle(SensorSize s, const Variant& v, const std::vector<Event>& ev, std::uint64_t seed,
+                         std::size_t& corners, std::size_t& scored, std::size_t count_from = 0) {
+    FaHarris fast(s, v.params), batch(s, v.params);
+    naive::FaHarrisNaive oracle(s, v.params);
+    std::vector<std::uint8_t> flags(ev.size());
+    detect(batch, std::span<const Event>(ev), flags);
+    for (std::size_t i = 0; i < ev.size(); ++i) {
+        const bool want = oracle.process(ev[i]);
+        ASSERT_EQ(fast.process(ev[i]), want) << v.name << " seed " << seed << " event " << i;
+        ASSERT_EQ(flags[i] != 0, want) << v.name << " (detect) seed " << seed << " event " << i;
+        ASSERT_TRUE(same_score(fast.last_score(), oracle.last_score()))
+            << v.name << " seed " << seed << " event " << i << ": " << fast.last_score() << " vs "
+            << oracle.last_score();
+        corners += want;
+        scored += i >= count_from && !std::isnan(oracle.last_score());
+    }
+}
+
 class FaHarrisVsOracle : public ::testing::TestWithParam<SensorSize> {};
 
 TEST_P(FaHarrisVsOracle, SameCornersAndScoresEventForEvent) {
@@ -59,20 +81,7 @@ TEST_P(FaHarrisVsOracle, SameCornersAndScoresEventForEvent) {
         for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
             const auto ev = test::arcstar_stream(s, n, seed * 104729 + static_cast<std::uint64_t>(s.height), v.step_us,
                                                  v.pause_us);
-            FaHarris fast(s, v.params), batch(s, v.params);
-            naive::FaHarrisNaive oracle(s, v.params);
-            std::vector<std::uint8_t> flags(ev.size());
-            detect(batch, std::span<const Event>(ev), flags);  // the AVX2 loop where the CPU has it
-            for (std::size_t i = 0; i < ev.size(); ++i) {
-                const bool want = oracle.process(ev[i]);
-                ASSERT_EQ(fast.process(ev[i]), want) << v.name << " seed " << seed << " event " << i;
-                ASSERT_EQ(flags[i] != 0, want) << v.name << " (detect) seed " << seed << " event " << i;
-                ASSERT_TRUE(same_score(fast.last_score(), oracle.last_score()))
-                    << v.name << " seed " << seed << " event " << i << ": " << fast.last_score() << " vs "
-                    << oracle.last_score();
-                corners += want;
-                scored += !std::isnan(oracle.last_score());
-            }
+            ASSERT_NO_FATAL_FAILURE(compare_with_oracle(s, v, ev, seed, corners, scored));
             ++streams;
             events += ev.size();
         }
@@ -92,6 +101,29 @@ INSTANTIATE_TEST_SUITE_P(Sizes, FaHarrisVsOracle,
                          [](const auto& info) {
                              return std::to_string(info.param.width) + "x" + std::to_string(info.param.height);
                          });
+
+// Streams whose times are in order for the first half and then often go back (up to
+// 5 ms): FA-Harris selects the newest nl on arrival numbers while every filtered write
+// came in time order, and by (time, arrival) from the first one that did not; both halves
+// against the oracle, on a window of 9 (the vector selections) and of 7.
+TEST(FaHarrisOutOfOrder, TimesGoBackFromHalfWayAsTheOracle) {
+    std::size_t corners = 0, scored_after = 0, back = 0;
+    for (const SensorSize s : {SensorSize{240, 180}, SensorSize{17, 13}})
+        for (const Variant& v : {kVariants[0], kVariants[1], kVariants[4]})
+            for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+                auto ev = test::arcstar_stream(s, 30000, seed * 7919 + static_cast<std::uint64_t>(s.width), v.step_us,
+                                               v.pause_us);
+                std::mt19937_64 rng(seed);
+                for (std::size_t i = ev.size() / 2; i < ev.size(); ++i)
+                    if (rng() % 4 == 0) {
+                        ev[i].t -= static_cast<std::int64_t>(rng() % 5001);
+                        back += ev[i].t < ev[i - 1].t;
+                    }
+                ASSERT_NO_FATAL_FAILURE(compare_with_oracle(s, v, ev, seed, corners, scored_after, ev.size() / 2));
+            }
+    EXPECT_GT(back, 1000u);
+    EXPECT_GT(scored_after, 100u);
+}
 
 // ---- drawn grids
 
@@ -211,6 +243,27 @@ TEST(FaHarrisGrid, TiesAreBrokenByArrival) {
     EXPECT_EQ(e.score, plain.score);
     EXPECT_NE(l.score, plain.score);
     EXPECT_FALSE(std::isnan(l.score));
+}
+
+TEST(FaHarrisGrid, NewestIsByTimeNotByArrival) {
+    // The outside corner's quadrant (time 9) arrives first and the background (time 2)
+    // after it: the 25 newest are still the quadrant's, a lit 5x5 quadrant, as when the
+    // grid arrives in time order.
+    const SensorSize size{20, 20};
+    FaHarris fast(size);
+    naive::FaHarrisNaive oracle(size);
+    int ex = -1, ey = -1;
+    auto cells = test::parse_grid(kOutsideCorner, 5, 5, ex, ey);
+    std::stable_sort(cells.begin(), cells.end(), [](const auto& a, const auto& b) { return a.t > b.t; });
+    for (const auto& c : cells) {
+        const Event e{c.t, static_cast<std::uint16_t>(c.x), static_cast<std::uint16_t>(c.y), 0};
+        EXPECT_EQ(fast.process(e), oracle.process(e));
+    }
+    const Event e{1000, static_cast<std::uint16_t>(ex), static_cast<std::uint16_t>(ey), 0};
+    EXPECT_TRUE(fast.process(e));
+    EXPECT_TRUE(oracle.process(e));
+    EXPECT_EQ(fast.last_score(), run_grid(kOutsideCorner).score);
+    EXPECT_NEAR(fast.last_score(), 14.45, 0.1);
 }
 
 TEST(FaHarrisGrid, FewerThanNlFilteredPixelsIsNoCorner) {

@@ -24,6 +24,7 @@
 #include "evcorner/event.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/harris_score.hpp"
+#include "evcorner/harris_select.hpp"
 #include "evcorner/sae.hpp"
 #include "evcorner/scored_detector.hpp"
 #include "evcorner/sensor.hpp"
@@ -105,6 +106,11 @@ private:
     ZeroedArray<std::uint64_t> arrival_;  // 2 framed planes, arrival numbers (0 = never)
     std::uint64_t arrivals_ = 0;
     std::int64_t newest_ = 0;             // the largest stored time in the filtered SAE
+    // Whether every filtered write so far came in time order (no time below an earlier
+    // one): then "later time, ties by later arrival" is "later arrival", and the newest nl
+    // are selected on the arrival numbers alone (harris_select.hpp).
+    bool in_time_order_ = true;
+    HarrisPath path_;                     // harris_default_path(): selection and 9x9 score
     double score_ = kNoScore;
 };
 static_assert(ScoredDetector<FaHarris>);
