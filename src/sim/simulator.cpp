@@ -172,7 +172,10 @@ void Simulator::place_objects(double t_us) {
 // step (step()), so a pixel whose coverage differs between the two ends of a step is touched
 // by an edge at one end: a pixel wholly outside an object at one end and wholly inside at the
 // other would need its boundary to sweep over the whole pixel.
-template <bool Dual>
+// A moving object (Moving) marks the pixels and keeps no written bits: every cell its walk
+// writes is a marked pixel or the one right of it, or column 0 (the part of an edge left of
+// the sensor), and render() reads those. A still object, walked once, keeps written bits.
+template <bool Dual, bool Moving>
 struct Simulator::AccSink {
     double* cov;  // the window's cell (0, 0), i.e. sensor (acc.y0, acc.x0)
     double* val;
@@ -196,13 +199,15 @@ struct Simulator::AccSink {
             val[cell] += w0;
             val[cell + 1] += w1;
         }
-        std::uint64_t* wr = written + row * words + (c >> 6);
-        const unsigned bit = static_cast<unsigned>(c) & 63u;
-        wr[0] |= std::uint64_t{3} << bit;  // cells c and c + 1 (the latter in the next word when bit is 63)
-        if (bit == 63) wr[1] |= 1;
-        if (marks != nullptr)
+        if constexpr (Moving) {
             marks[static_cast<std::size_t>(r) * mwords + (static_cast<unsigned>(k) >> 6)] |=
                 std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
+        } else {
+            std::uint64_t* wr = written + row * words + (c >> 6);
+            const unsigned bit = static_cast<unsigned>(c) & 63u;
+            wr[0] |= std::uint64_t{3} << bit;  // cells c and c + 1 (the latter in the next word when bit is 63)
+            if (bit == 63) wr[1] |= 1;
+        }
     }
     // A single addition (at column 0, for the part of an edge left of the sensor, which
     // covers no pixel of its own).
@@ -211,14 +216,14 @@ struct Simulator::AccSink {
         const std::size_t c = static_cast<std::size_t>(k - x0);
         cov[row * cells + c] += v;
         if constexpr (Dual) val[row * cells + c] += w2;
-        written[row * words + (c >> 6)] |= std::uint64_t{1} << (c & 63u);
+        if constexpr (!Moving) written[row * words + (c >> 6)] |= std::uint64_t{1} << (c & 63u);
     }
     void span(int r, double, double) noexcept {
         if (r < my0) my0 = r;
         if (r > my1) my1 = r;
     }
     void flat(double y, double xl, double xr) noexcept {
-        if (marks == nullptr || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
+        if (!Moving || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
         const double lo_x = xl - kMarkMargin, hi_x = xr + kMarkMargin;
         if (hi_x < 0 || lo_x >= w) return;
         const int lo = lo_x <= 0 ? 0 : static_cast<int>(lo_x);  // truncation is floor for x >= 0
@@ -250,18 +255,25 @@ void Simulator::walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y
     const std::size_t rows = static_cast<std::size_t>(r.y1 - r.y0 + 1);
     const bool dual = obj.pieces.size() > 1;
     // Growing keeps the cells zero (every cell is zero between renders).
-    if (acc.written.size() < rows * acc.words) acc.written.resize(rows * acc.words);
+    if (marks == nullptr && acc.written.size() < rows * acc.words) acc.written.resize(rows * acc.words);
     if (acc.cov.size() < rows * acc.words * 64) acc.cov.resize(rows * acc.words * 64);
     if (dual && acc.val.size() < rows * acc.words * 64) acc.val.resize(rows * acc.words * 64);
+    auto walk = [&]<bool Dual, bool Moving>() {
+        AccSink<Dual, Moving> sink{acc.cov.data(), Dual ? acc.val.data() : nullptr, Moving ? nullptr : acc.written.data(),
+                                   acc.words * 64, acc.words, acc.x0, acc.y0, marks, y0, y1, words_, w_, h_};
+        if constexpr (Dual) {
+            for (std::size_t k = 0; k < obj.pieces.size(); ++k)
+                walk_coverage<true>(polys_[o][k], 1.0, obj.pieces[k].intensity, w_, h_, sink);
+        } else {
+            walk_coverage<false>(polys_[o][0], 1.0, 0.0, w_, h_, sink);
+        }
+    };
     if (dual) {
-        AccSink<true> sink{acc.cov.data(), acc.val.data(), acc.written.data(), acc.words * 64, acc.words, acc.x0, acc.y0,
-                           marks, y0, y1, words_, w_, h_};
-        for (std::size_t k = 0; k < obj.pieces.size(); ++k)
-            walk_coverage<true>(polys_[o][k], 1.0, obj.pieces[k].intensity, w_, h_, sink);
+        if (marks != nullptr) walk.template operator()<true, true>();
+        else walk.template operator()<true, false>();
     } else {
-        AccSink<false> sink{acc.cov.data(), nullptr, acc.written.data(), acc.words * 64, acc.words, acc.x0, acc.y0,
-                            marks, y0, y1, words_, w_, h_};
-        walk_coverage<false>(polys_[o][0], 1.0, 0.0, w_, h_, sink);
+        if (marks != nullptr) walk.template operator()<false, true>();
+        else walk.template operator()<false, false>();
     }
 }
 
@@ -324,34 +336,51 @@ double Simulator::render(bool all_rows) {
             const std::size_t row = static_cast<std::size_t>(y - acc.y0);
             double* ac = acc.cov.data() + row * cells;
             double* ai = multi ? acc.val.data() + row * cells : nullptr;
-            std::uint64_t* wr = acc.written.data() + row * acc.words;
             double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
-            const std::uint64_t* d = y >= dirty_y0_ && y <= dirty_y1_ ? row_bits(dirty_, y) + kw : zero_row_.data();
+            const bool in_dirty = y >= dirty_y0_ && y <= dirty_y1_;
+            const std::uint64_t* d = in_dirty ? row_bits(dirty_, y) + kw : zero_row_.data();
             // The running sums over the window's cells, in column order: adding 0 leaves a
-            // sum as it is, so only the cells the walk wrote are added; composited where the
-            // row is dirty. A moving object's cells are cleared as they are read; cells the
-            // walk wrote outside the object's columns (r.x0 - 1 by rounding) are cleared, not
-            // added.
+            // sum as it is, so only the cells the walk may have written are added; composited
+            // where the row is dirty. A still object's written cells are its written bits; a
+            // moving object's are among its marked pixels (all dirty) and the cells right of
+            // them, and column 0; those are read and cleared. Cells the walk wrote outside the
+            // object's columns (r.x0 - 1 by rounding) are cleared, not added.
             double b = 0, s = 0;
+            if (!moving) {
+                const std::uint64_t* wr = acc.written.data() + row * acc.words;
+                for (std::size_t j = 0; j < acc.words; ++j) {
+                    const std::uint64_t inside = word_mask(kw + j, r.x0, r.x1);
+                    const std::uint64_t dm = d[j] & inside;
+                    for (std::uint64_t m = (wr[j] & inside) | dm; m != 0; m &= m - 1) {
+                        const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                        b += ac[c];
+                        if (multi) s += ai[c];
+                        if ((dm & (m & -m)) == 0 || b <= kSnap) continue;
+                        const double bc = b >= 1.0 - kSnap ? 1.0 : b;
+                        out[c] = out[c] * (1.0 - bc) + (multi ? s : bc * level);
+                    }
+                }
+                continue;
+            }
+            std::uint64_t carry = kw > 0 && in_dirty ? d[-1] >> 63 : 0;  // the cell right of a dirty one
+            if (acc.x0 == 0) carry |= 1;                                  // column 0
             for (std::size_t j = 0; j < acc.words; ++j) {
                 const std::uint64_t inside = word_mask(kw + j, r.x0, r.x1);
                 const std::uint64_t dm = d[j] & inside;
-                std::uint64_t m = (wr[j] & inside) | dm;
-                if (moving) {
-                    for (std::uint64_t e = wr[j] & ~inside; e != 0; e &= e - 1) {
-                        const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(e));
-                        ac[c] = 0;
-                        if (multi) ai[c] = 0;
-                    }
-                    wr[j] = 0;
+                const std::uint64_t wm = d[j] | (d[j] << 1) | carry;
+                carry = d[j] >> 63;
+                for (std::uint64_t e = wm & ~inside; e != 0; e &= e - 1) {
+                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(e));
+                    ac[c] = 0;
+                    if (multi) ai[c] = 0;
                 }
-                for (; m != 0; m &= m - 1) {
+                for (std::uint64_t m = wm & inside; m != 0; m &= m - 1) {
                     const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
                     b += ac[c];
-                    if (moving) ac[c] = 0;
+                    ac[c] = 0;
                     if (multi) {
                         s += ai[c];
-                        if (moving) ai[c] = 0;
+                        ai[c] = 0;
                     }
                     if ((dm & (m & -m)) == 0 || b <= kSnap) continue;
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;

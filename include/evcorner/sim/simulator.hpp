@@ -74,8 +74,8 @@ private:
     // An object's own accumulators: its edge walk's additions (coverage_walk.hpp) into a
     // window of rows y0 .. y1 and of words columns from x0 (a multiple of 64) that holds every
     // cell the walk can write at the time being rendered. cov gets the coverage additions, val
-    // (a checkerboard only) the intensity-weighted ones; written has a bit per cell the walk
-    // wrote. A moving object's cells are cleared as the compositing reads them (all zero
+    // (a checkerboard only) the intensity-weighted ones; written (a still object's only) has a
+    // bit per cell the walk wrote. A moving object's cells are cleared as the compositing reads them (all zero
     // between renders, whatever the window); a still object's are written once and kept.
     struct ObjectAcc {
         int x0 = 0, y0 = 0, y1 = -1;
@@ -83,11 +83,12 @@ private:
         std::vector<double> cov, val;
         std::vector<std::uint64_t> written;
     };
-    template <bool Dual>
+    template <bool Dual, bool Moving>
     struct AccSink;
     // Sizes object o's window for its rectangle (rects_[o]) and walks its edges as placed in
-    // polys_ into it; with marks, also marks the pixels its edges touch (rows y0 .. y1 grow to
-    // hold them). An object off the sensor is not walked (its window is empty).
+    // polys_ into it. With marks (a moving object) it also marks the pixels its edges touch
+    // (rows y0 .. y1 grow to hold them) and keeps no written bits; without (a still object,
+    // walked once) it keeps them. An object off the sensor is not walked (its window is empty).
     void walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
