@@ -332,6 +332,9 @@ double Simulator::render(bool all_rows) {
         ObjectAcc& acc = acc_[o];
         const std::size_t cells = acc.words * 64;
         const std::size_t kw = static_cast<std::size_t>(acc.x0) / 64;  // the window's first sensor word
+        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row).
+        inside_.resize(std::max(inside_.size(), acc.words));
+        for (std::size_t j = 0; j < acc.words; ++j) inside_[j] = word_mask(kw + j, r.x0, r.x1);
         for (int y = r.y0; y <= r.y1; ++y) {
             const std::size_t row = static_cast<std::size_t>(y - acc.y0);
             double* ac = acc.cov.data() + row * cells;
@@ -349,7 +352,7 @@ double Simulator::render(bool all_rows) {
             if (!moving) {
                 const std::uint64_t* wr = acc.written.data() + row * acc.words;
                 for (std::size_t j = 0; j < acc.words; ++j) {
-                    const std::uint64_t inside = word_mask(kw + j, r.x0, r.x1);
+                    const std::uint64_t inside = inside_[j];
                     const std::uint64_t dm = d[j] & inside;
                     for (std::uint64_t m = (wr[j] & inside) | dm; m != 0; m &= m - 1) {
                         const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
@@ -365,7 +368,7 @@ double Simulator::render(bool all_rows) {
             std::uint64_t carry = kw > 0 && in_dirty ? d[-1] >> 63 : 0;  // the cell right of a dirty one
             if (acc.x0 == 0) carry |= 1;                                  // column 0
             for (std::size_t j = 0; j < acc.words; ++j) {
-                const std::uint64_t inside = word_mask(kw + j, r.x0, r.x1);
+                const std::uint64_t inside = inside_[j];
                 const std::uint64_t dm = d[j] & inside;
                 const std::uint64_t wm = d[j] | (d[j] << 1) | carry;
                 carry = d[j] >> 63;

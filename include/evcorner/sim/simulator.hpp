@@ -120,6 +120,7 @@ private:
     // dirty_ is their union (valid over dirty_y0_ .. dirty_y1_), the pixels recomputed.
     std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, zero_row_;
     int cur_y0_ = 0, cur_y1_ = -1, prev_y0_ = 0, prev_y1_ = -1, dirty_y0_ = 0, dirty_y1_ = -1;
+    std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
     std::vector<std::uint32_t> changed_;  // the dirty pixels whose next_ differs from cur_
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
