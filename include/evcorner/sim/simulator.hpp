@@ -20,7 +20,8 @@
 //               t = 0); events sorted by (t, y, x, p) within a step, steps in time order
 //
 // Streaming: step() hands out one step's events at a time; memory is a few arrays the size
-// of the sensor, whatever the duration. Steps are also short enough that no vertex moves
+// of the sensor (and each object's accumulator window, at most that size), whatever the
+// duration. Steps are also short enough that no vertex moves
 // 0.75 px; then only the pixels a moving edge passes through (before or after the step) can
 // change, and only they are recomputed (kept as per-row bitmaps; each object's coverage is
 // summed along a row only at the columns its edges wrote): the work per step follows the
