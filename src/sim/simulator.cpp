@@ -385,16 +385,21 @@ double Simulator::render(bool all_rows) {
                         s += ai[c];
                         ai[c] = 0;
                     }
-                    if ((dm & (m & -m)) == 0 || b <= kSnap) continue;
+                    // Composited where dirty and covered, without a branch (the same value as
+                    // a branch would store).
+                    const bool comp = (dm & (m & -m)) != 0 && b > kSnap;
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;
-                    out[c] = out[c] * (1.0 - bc) + (multi ? s : bc * level);
+                    const double v = out[c] * (1.0 - bc) + (multi ? s : bc * level);
+                    out[c] = comp ? v : out[c];
                 }
             }
         }
     }
     // The dirty pixels that changed, and max |dL| over them, bounded by |dI| / (eps + min I)
     // (log is concave).
-    changed_.clear();
+    changed_.resize(cur_.size());  // room for every pixel (only the first nc are kept)
+    std::uint32_t* ch = changed_.data();
+    std::size_t nc = 0;
     double worst = 0;
     for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
         const std::uint64_t* d = row_bits(dirty_, y);
@@ -403,14 +408,15 @@ double Simulator::render(bool all_rows) {
             for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
                 const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
                 const double a = cur_[i], b = next_[i];
-                if (a == b) continue;
-                changed_.push_back(static_cast<std::uint32_t>(i));
-                // Divides only where the quotient may exceed worst (the slack covers the
-                // product's rounding, so worst ends exactly the largest quotient).
+                // Without branches: every dirty pixel's index is written, kept when it
+                // changed; an unchanged one has quotient 0.
+                ch[nc] = static_cast<std::uint32_t>(i);
+                nc += a != b ? 1 : 0;
                 const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
-                if (d >= worst * den * (1.0 - 1e-9)) worst = std::max(worst, d / den);
+                worst = std::max(worst, d / den);
             }
     }
+    changed_n_ = nc;
     return all_rows ? 0 : worst;
 }
 
@@ -440,7 +446,7 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         last_[p] = ts;
         ev.push_back({ts, static_cast<std::uint16_t>(p % w), static_cast<std::uint16_t>(p / w), pol});
     };
-    for (const std::uint32_t pix : changed_) {
+    for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
         const std::size_t p = pix;
         const double a = cur_[p], b = next_[p];
         cur_[p] = b;

@@ -122,7 +122,8 @@ private:
     std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, zero_row_;
     int cur_y0_ = 0, cur_y1_ = -1, prev_y0_ = 0, prev_y1_ = -1, dirty_y0_ = 0, dirty_y1_ = -1;
     std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
-    std::vector<std::uint32_t> changed_;  // the dirty pixels whose next_ differs from cur_
+    std::vector<std::uint32_t> changed_;  // its first changed_n_: the dirty pixels whose next_ differs from cur_
+    std::size_t changed_n_ = 0;
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
     double noise_rate_per_us_ = 0;
