@@ -68,13 +68,10 @@ Simulator::Simulator(Scene scene)
     bg_ = background_image(scene_.background, scene_.sensor, scene_.seed);
     cur_.assign(n, 0.0);
     next_.assign(n, 0.0);
-    acc_cov_.assign(stride_ * static_cast<std::size_t>(h_), 0.0);
-    acc_int_.assign(stride_ * static_cast<std::size_t>(h_), 0.0);
     const std::size_t bitmap_words = words_ * static_cast<std::size_t>(h_);
     cur_marks_.assign(bitmap_words, 0);
     prev_marks_.assign(bitmap_words, 0);
     dirty_.assign(bitmap_words, 0);
-    written_.assign(bitmap_words, 0);
     zero_row_.assign(words_, 0);
     polys_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) polys_[o].resize(scene_.objects[o].pieces.size());
@@ -90,7 +87,7 @@ Simulator::Simulator(Scene scene)
     }
     // Every object's edge walk at t = 0 (a still object's is kept for the whole run), the
     // moving ones' edges marked as the pixels near them at time_us().
-    terms_.resize(scene_.objects.size());
+    acc_.resize(scene_.objects.size());
     prev_y0_ = h_;
     prev_y1_ = -1;
     for (std::size_t o = 0; o < scene_.objects.size(); ++o)
@@ -167,58 +164,66 @@ void Simulator::place_objects(double t_us) {
 }
 
 
-// Collects an object's edge walk as Terms and, when `marks` is set, marks every pixel an
-// edge passes through in rows [y0, y1], which grow to hold the rows marked: the cell of every
-// piece of a slanted edge (the computed coverage of a pixel without one is a sum of whole
-// piece heights, 0 or 1 up to rounding that kSnap removes) and every cell a horizontal edge
-// meets (widened by kMarkMargin). Edges move less than kMaxMove (< 1 px) per step (step()),
-// so a pixel whose coverage differs between the two ends of a step is touched by an edge at
-// one end: a pixel wholly outside an object at one end and wholly inside at the other would
-// need its boundary to sweep over the whole pixel.
-template <bool Dual>
-struct Simulator::TermSink {
-    TermList& list;
-    Term* out;  // next free term of list.buf
-    Term* cap;  // end of list.buf
+// Adds an object's edge walk into its window (ObjectAcc) and, when `marks` is set, marks
+// every pixel an edge passes through in rows [y0, y1], which grow to hold the rows marked:
+// the cell of every piece of a slanted edge (the computed coverage of a pixel without one is
+// a sum of whole piece heights, 0 or 1 up to rounding that kSnap removes) and every cell a
+// horizontal edge meets (widened by kMarkMargin). Edges move less than kMaxMove (< 1 px) per
+// step (step()), so a pixel whose coverage differs between the two ends of a step is touched
+// by an edge at one end: a pixel wholly outside an object at one end and wholly inside at the
+// other would need its boundary to sweep over the whole pixel.
+// A moving object (Moving) marks the pixels and keeps no written bits: every cell its walk
+// writes is a marked pixel or the one right of it, or column 0 (the part of an edge left of
+// the sensor), and render() reads those. A still object, walked once, keeps written bits.
+template <bool Dual, bool Moving>
+struct Simulator::AccSink {
+    double* cov;  // the window's cell (0, 0), i.e. sensor (acc.y0, acc.x0)
+    double* val;
+    std::uint64_t* written;
+    std::size_t cells;  // per window row
+    std::size_t words;  // per window row
+    int x0, y0;
     std::uint64_t* marks;
-    int& y0;
-    int& y1;
-    std::size_t stride, words;
+    int& my0;
+    int& my1;
+    std::size_t mwords;
     int w, h;
 
-    Term* grow() {
-        const std::size_t n = static_cast<std::size_t>(out - list.buf.data());
-        list.buf.resize(std::max<std::size_t>(64, 2 * list.buf.size()));
-        cap = list.buf.data() + list.buf.size();
-        return out = list.buf.data() + n;
-    }
-    void push(int r, int k, double v0, double v1, double w0, double w1) {
-        Term* t = out == cap ? grow() : out;
-        t->cell = static_cast<std::uint32_t>(static_cast<std::size_t>(r) * stride + static_cast<std::size_t>(k));
-        t->row = static_cast<std::uint32_t>(r);
-        t->v0 = v0;
-        t->v1 = v1;
-        if constexpr (Dual) {
-            t->w0 = w0;
-            t->w1 = w1;
-        }
-        out = t + 1;
-    }
     void add_pair(int r, int k, double v0, double v1, double w0, double w1) {
-        push(r, k, v0, v1, w0, w1);
-        if (marks != nullptr)
-            marks[static_cast<std::size_t>(r) * words + (static_cast<unsigned>(k) >> 6)] |=
+        const std::size_t row = static_cast<std::size_t>(r - y0);
+        const std::size_t c = static_cast<std::size_t>(k - x0);
+        const std::size_t cell = row * cells + c;
+        cov[cell] += v0;
+        cov[cell + 1] += v1;
+        if constexpr (Dual) {
+            val[cell] += w0;
+            val[cell + 1] += w1;
+        }
+        if constexpr (Moving) {
+            marks[static_cast<std::size_t>(r) * mwords + (static_cast<unsigned>(k) >> 6)] |=
                 std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
+        } else {
+            std::uint64_t* wr = written + row * words + (c >> 6);
+            const unsigned bit = static_cast<unsigned>(c) & 63u;
+            wr[0] |= std::uint64_t{3} << bit;  // cells c and c + 1 (the latter in the next word when bit is 63)
+            if (bit == 63) wr[1] |= 1;
+        }
     }
     // A single addition (at column 0, for the part of an edge left of the sensor, which
-    // covers no pixel of its own) as a pair adding 0 to column 1: adding 0 changes no sum.
-    void add(int r, int k, double v, double w2) { push(r, k, v, 0.0, w2, 0.0); }
+    // covers no pixel of its own).
+    void add(int r, int k, double v, double w2) {
+        const std::size_t row = static_cast<std::size_t>(r - y0);
+        const std::size_t c = static_cast<std::size_t>(k - x0);
+        cov[row * cells + c] += v;
+        if constexpr (Dual) val[row * cells + c] += w2;
+        if constexpr (!Moving) written[row * words + (c >> 6)] |= std::uint64_t{1} << (c & 63u);
+    }
     void span(int r, double, double) noexcept {
-        if (r < y0) y0 = r;
-        if (r > y1) y1 = r;
+        if (r < my0) my0 = r;
+        if (r > my1) my1 = r;
     }
     void flat(double y, double xl, double xr) noexcept {
-        if (marks == nullptr || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
+        if (!Moving || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
         const double lo_x = xl - kMarkMargin, hi_x = xr + kMarkMargin;
         if (hi_x < 0 || lo_x >= w) return;
         const int lo = lo_x <= 0 ? 0 : static_cast<int>(lo_x);  // truncation is floor for x >= 0
@@ -226,7 +231,7 @@ struct Simulator::TermSink {
         const int r0 = std::max(0, static_cast<int>(std::floor(y - kMarkMargin)));
         const int r1 = std::min(h - 1, static_cast<int>(std::floor(y + kMarkMargin)));
         for (int r = r0; r <= r1; ++r) {
-            set_range(marks + static_cast<std::size_t>(r) * words, lo, hi);
+            set_range(marks + static_cast<std::size_t>(r) * mwords, lo, hi);
             span(r, xl, xr);
         }
     }
@@ -234,16 +239,41 @@ struct Simulator::TermSink {
 
 void Simulator::walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1) {
     const Object& obj = scene_.objects[o];
-    TermList& list = terms_[o];
-    if (obj.pieces.size() > 1) {
-        TermSink<true> sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
-        for (std::size_t k = 0; k < obj.pieces.size(); ++k)
-            walk_coverage<true>(polys_[o][k], 1.0, obj.pieces[k].intensity, w_, h_, sink);
-        list.n = static_cast<std::size_t>(sink.out - list.buf.data());
+    ObjectAcc& acc = acc_[o];
+    const Rect& r = rects_[o];
+    if (r.empty()) {  // off the sensor: no pixel to cover, nothing to mark
+        acc.y1 = acc.y0 - 1;
+        return;
+    }
+    // The walk writes rows r.y0 .. r.y1 (those of the vertices) and columns from r.x0 - 1
+    // (rounding can put a vertex on a column line a hair to its left) to r.x1 + 2 (a cell and
+    // its right neighbour, the cell again one further by rounding), within 0 .. w_.
+    acc.x0 = std::max(0, r.x0 - 1) & ~63;
+    acc.y0 = r.y0;
+    acc.y1 = r.y1;
+    acc.words = static_cast<std::size_t>(std::min(w_, r.x1 + 2) - acc.x0) / 64 + 1;
+    const std::size_t rows = static_cast<std::size_t>(r.y1 - r.y0 + 1);
+    const bool dual = obj.pieces.size() > 1;
+    // Growing keeps the cells zero (every cell is zero between renders).
+    if (marks == nullptr && acc.written.size() < rows * acc.words) acc.written.resize(rows * acc.words);
+    if (acc.cov.size() < rows * acc.words * 64) acc.cov.resize(rows * acc.words * 64);
+    if (dual && acc.val.size() < rows * acc.words * 64) acc.val.resize(rows * acc.words * 64);
+    auto walk = [&]<bool Dual, bool Moving>() {
+        AccSink<Dual, Moving> sink{acc.cov.data(), Dual ? acc.val.data() : nullptr, Moving ? nullptr : acc.written.data(),
+                                   acc.words * 64, acc.words, acc.x0, acc.y0, marks, y0, y1, words_, w_, h_};
+        if constexpr (Dual) {
+            for (std::size_t k = 0; k < obj.pieces.size(); ++k)
+                walk_coverage<true>(polys_[o][k], 1.0, obj.pieces[k].intensity, w_, h_, sink);
+        } else {
+            walk_coverage<false>(polys_[o][0], 1.0, 0.0, w_, h_, sink);
+        }
+    };
+    if (dual) {
+        if (marks != nullptr) walk.template operator()<true, true>();
+        else walk.template operator()<true, false>();
     } else {
-        TermSink<false> sink{list, list.buf.data(), list.buf.data() + list.buf.size(), marks, y0, y1, stride_, words_, w_, h_};
-        walk_coverage<false>(polys_[o][0], 1.0, 0.0, w_, h_, sink);
-        list.n = static_cast<std::size_t>(sink.out - list.buf.data());
+        if (marks != nullptr) walk.template operator()<false, true>();
+        else walk.template operator()<false, false>();
     }
 }
 
@@ -285,80 +315,91 @@ double Simulator::render(bool all_rows) {
     for (std::size_t o = 0; o < rects_.size(); ++o) {
         const Rect& r = rects_[o];
         if (r.empty()) continue;
-        bool touches = false;
-        const int ty0 = std::max(r.y0, dirty_y0_), ty1 = std::min(r.y1, dirty_y1_);
-        for (int y = ty0; y <= ty1 && !touches; ++y) {
-            const std::uint64_t* d = row_bits(dirty_, y);
-            for (std::size_t k = static_cast<std::size_t>(r.x0) / 64; k <= static_cast<std::size_t>(r.x1) / 64; ++k)
-                touches = touches || (d[k] & word_mask(k, r.x0, r.x1)) != 0;
+        const bool moving = moving_[o] != 0;
+        if (!moving) {  // a still object's window is kept: only pixels marked dirty need it
+            bool touches = false;
+            const int ty0 = std::max(r.y0, dirty_y0_), ty1 = std::min(r.y1, dirty_y1_);
+            for (int y = ty0; y <= ty1 && !touches; ++y) {
+                const std::uint64_t* d = row_bits(dirty_, y);
+                for (std::size_t k = static_cast<std::size_t>(r.x0) / 64; k <= static_cast<std::size_t>(r.x1) / 64; ++k)
+                    touches = touches || (d[k] & word_mask(k, r.x0, r.x1)) != 0;
+            }
+            if (!touches) continue;
         }
-        if (!touches) continue;
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
-        // The object's edge walk into the accumulators (the additions in the walk's order,
-        // so each entry gets exactly the sum accumulate_polygon would give it).
-        {
-            double* ac = acc_cov_.data();
-            double* ai = acc_int_.data();
-            std::uint64_t* wr = written_.data();
-            const std::size_t bits_per_row = words_ * 64;
-            const TermList& list = terms_[o];
-            for (const Term* t = list.buf.data(); t != list.buf.data() + list.n; ++t) {
-                ac[t->cell] += t->v0;
-                ac[t->cell + 1] += t->v1;
-                if (multi) {
-                    ai[t->cell] += t->w0;
-                    ai[t->cell + 1] += t->w1;
-                }
-                const std::size_t k = t->cell - static_cast<std::size_t>(t->row) * stride_;
-                const std::size_t bit = static_cast<std::size_t>(t->row) * bits_per_row + k;
-                wr[bit >> 6] |= std::uint64_t{1} << (bit & 63u);
-                wr[(bit + 1) >> 6] |= std::uint64_t{1} << ((bit + 1) & 63u);
-            }
-        }
         const double level = obj.pieces[0].intensity;
-        // The accumulation writes columns r.x0 .. r.x1 + 1 (r.x0 - 1 when rounding puts a
-        // vertex on a column line a hair to its left: that entry is cleared, not added).
-        const std::size_t k0 = static_cast<std::size_t>(std::max(0, r.x0 - 1)) / 64;
-        const std::size_t k1 = static_cast<std::size_t>(r.x1 + 1) / 64;
+        ObjectAcc& acc = acc_[o];
+        const std::size_t cells = acc.words * 64;
+        const std::size_t kw = static_cast<std::size_t>(acc.x0) / 64;  // the window's first sensor word
+        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row).
+        inside_.resize(std::max(inside_.size(), acc.words));
+        for (std::size_t j = 0; j < acc.words; ++j) inside_[j] = word_mask(kw + j, r.x0, r.x1);
         for (int y = r.y0; y <= r.y1; ++y) {
-            double* ac = &acc_cov_[static_cast<std::size_t>(y) * stride_];
-            double* ai = &acc_int_[static_cast<std::size_t>(y) * stride_];
-            double* out = &next_[static_cast<std::size_t>(y) * w];
-            std::uint64_t* wr = row_bits(written_, y);
-            const std::uint64_t* d = y >= dirty_y0_ && y <= dirty_y1_ ? row_bits(dirty_, y) : zero_row_.data();
-            // The running sums over the object's columns, in column order: adding 0 leaves a
-            // sum as it is, so only the columns an edge wrote are added; composited where the
-            // row is dirty.
+            const std::size_t row = static_cast<std::size_t>(y - acc.y0);
+            double* ac = acc.cov.data() + row * cells;
+            double* ai = multi ? acc.val.data() + row * cells : nullptr;
+            double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
+            const bool in_dirty = y >= dirty_y0_ && y <= dirty_y1_;
+            const std::uint64_t* d = in_dirty ? row_bits(dirty_, y) + kw : zero_row_.data();
+            // The running sums over the window's cells, in column order: adding 0 leaves a
+            // sum as it is, so only the cells the walk may have written are added; composited
+            // where the row is dirty. A still object's written cells are its written bits; a
+            // moving object's are among its marked pixels (all dirty) and the cells right of
+            // them, and column 0; those are read and cleared. Cells the walk wrote outside the
+            // object's columns (r.x0 - 1 by rounding) are cleared, not added.
             double b = 0, s = 0;
-            for (std::size_t k = k0; k <= k1; ++k) {
-                const std::uint64_t inside = word_mask(k, r.x0, r.x1);
-                const std::uint64_t dm = d[k] & inside;
-                for (std::uint64_t m = wr[k] & ~inside; m != 0; m &= m - 1) {
-                    const int x = static_cast<int>(k * 64) + std::countr_zero(m);
-                    ac[x] = 0;
-                    if (multi) ai[x] = 0;
-                }
-                std::uint64_t m = (wr[k] & inside) | dm;
-                wr[k] = 0;
-                for (; m != 0; m &= m - 1) {
-                    const int x = static_cast<int>(k * 64) + std::countr_zero(m);
-                    b += ac[x];
-                    ac[x] = 0;
-                    if (multi) {
-                        s += ai[x];
-                        ai[x] = 0;
+            if (!moving) {
+                const std::uint64_t* wr = acc.written.data() + row * acc.words;
+                for (std::size_t j = 0; j < acc.words; ++j) {
+                    const std::uint64_t inside = inside_[j];
+                    const std::uint64_t dm = d[j] & inside;
+                    for (std::uint64_t m = (wr[j] & inside) | dm; m != 0; m &= m - 1) {
+                        const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                        b += ac[c];
+                        if (multi) s += ai[c];
+                        if ((dm & (m & -m)) == 0 || b <= kSnap) continue;
+                        const double bc = b >= 1.0 - kSnap ? 1.0 : b;
+                        out[c] = out[c] * (1.0 - bc) + (multi ? s : bc * level);
                     }
-                    if ((dm & (m & -m)) == 0 || b <= kSnap) continue;
+                }
+                continue;
+            }
+            std::uint64_t carry = kw > 0 && in_dirty ? d[-1] >> 63 : 0;  // the cell right of a dirty one
+            if (acc.x0 == 0) carry |= 1;                                  // column 0
+            for (std::size_t j = 0; j < acc.words; ++j) {
+                const std::uint64_t inside = inside_[j];
+                const std::uint64_t dm = d[j] & inside;
+                const std::uint64_t wm = d[j] | (d[j] << 1) | carry;
+                carry = d[j] >> 63;
+                for (std::uint64_t e = wm & ~inside; e != 0; e &= e - 1) {
+                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(e));
+                    ac[c] = 0;
+                    if (multi) ai[c] = 0;
+                }
+                for (std::uint64_t m = wm & inside; m != 0; m &= m - 1) {
+                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                    b += ac[c];
+                    ac[c] = 0;
+                    if (multi) {
+                        s += ai[c];
+                        ai[c] = 0;
+                    }
+                    // Composited where dirty and covered, without a branch (the same value as
+                    // a branch would store).
+                    const bool comp = (dm & (m & -m)) != 0 && b > kSnap;
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;
-                    out[x] = out[x] * (1.0 - bc) + (multi ? s : bc * level);
+                    const double v = out[c] * (1.0 - bc) + (multi ? s : bc * level);
+                    out[c] = comp ? v : out[c];
                 }
             }
         }
     }
     // The dirty pixels that changed, and max |dL| over them, bounded by |dI| / (eps + min I)
     // (log is concave).
-    changed_.clear();
+    changed_.resize(cur_.size());  // room for every pixel (only the first nc are kept)
+    std::uint32_t* ch = changed_.data();
+    std::size_t nc = 0;
     double worst = 0;
     for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
         const std::uint64_t* d = row_bits(dirty_, y);
@@ -367,14 +408,15 @@ double Simulator::render(bool all_rows) {
             for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
                 const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
                 const double a = cur_[i], b = next_[i];
-                if (a == b) continue;
-                changed_.push_back(static_cast<std::uint32_t>(i));
-                // Divides only where the quotient may exceed worst (the slack covers the
-                // product's rounding, so worst ends exactly the largest quotient).
+                // Without branches: every dirty pixel's index is written, kept when it
+                // changed; an unchanged one has quotient 0.
+                ch[nc] = static_cast<std::uint32_t>(i);
+                nc += a != b ? 1 : 0;
                 const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
-                if (d >= worst * den * (1.0 - 1e-9)) worst = std::max(worst, d / den);
+                worst = std::max(worst, d / den);
             }
     }
+    changed_n_ = nc;
     return all_rows ? 0 : worst;
 }
 
@@ -404,24 +446,26 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         last_[p] = ts;
         ev.push_back({ts, static_cast<std::uint16_t>(p % w), static_cast<std::uint16_t>(p / w), pol});
     };
-    for (const std::uint32_t pix : changed_) {
+    for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
         const std::size_t p = pix;
         const double a = cur_[p], b = next_[p];
         cur_[p] = b;
         if (b > a) {
-            while (b >= ion_[p]) {
+            if (b < ion_[p]) continue;
+            do {
                 emit(p, t0 + (ion_[p] - a) / (b - a) * dt, 1);
                 lref_[p] += con_[p];
                 ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
-                ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
-            }
+            } while (b >= ion_[p]);
+            ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;  // only the last reference's is needed
         } else {
-            while (b <= ioff_[p]) {
+            if (b > ioff_[p]) continue;
+            do {
                 emit(p, t0 + (ioff_[p] - a) / (b - a) * dt, 0);
                 lref_[p] -= coff_[p];
-                ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
                 ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
-            }
+            } while (b <= ioff_[p]);
+            ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
         }
     }
 }

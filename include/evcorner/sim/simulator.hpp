@@ -20,7 +20,8 @@
 //               t = 0); events sorted by (t, y, x, p) within a step, steps in time order
 //
 // Streaming: step() hands out one step's events at a time; memory is a few arrays the size
-// of the sensor, whatever the duration. Steps are also short enough that no vertex moves
+// of the sensor (and each object's accumulator window, at most that size), whatever the
+// duration. Steps are also short enough that no vertex moves
 // 0.75 px; then only the pixels a moving edge passes through (before or after the step) can
 // change, and only they are recomputed (kept as per-row bitmaps; each object's coverage is
 // summed along a row only at the columns its edges wrote): the work per step follows the
@@ -71,21 +72,24 @@ private:
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
     double render(bool all_rows);     // renders into next_ over the dirty pixels; returns max |dL| bound
-    // Two additions of an object's edge walk (coverage_walk.hpp): acc_cov_[cell] += v0,
-    // acc_cov_[cell + 1] += v1 (and w0, w1 into acc_int_ for a checkerboard), in sensor row `row`.
-    struct Term {
-        std::uint32_t cell, row;
-        double v0, v1, w0, w1;
+    // An object's own accumulators: its edge walk's additions (coverage_walk.hpp) into a
+    // window of rows y0 .. y1 and of words columns from x0 (a multiple of 64) that holds every
+    // cell the walk can write at the time being rendered. cov gets the coverage additions, val
+    // (a checkerboard only) the intensity-weighted ones; written (a still object's only) has a
+    // bit per cell the walk wrote. A moving object's cells are cleared as the compositing reads them (all zero
+    // between renders, whatever the window); a still object's are written once and kept.
+    struct ObjectAcc {
+        int x0 = 0, y0 = 0, y1 = -1;
+        std::size_t words = 0;  // 64-bit words (64 cells) per window row
+        std::vector<double> cov, val;
+        std::vector<std::uint64_t> written;
     };
-    // An object's terms: buf holds n of them (buf's size is only the capacity).
-    struct TermList {
-        std::vector<Term> buf;
-        std::size_t n = 0;
-    };
-    template <bool Dual>
-    struct TermSink;
-    // Walks object o's edges as placed in polys_ into terms_[o]; with marks, also marks the
-    // pixels its edges touch there (rows y0 .. y1 grow to hold them).
+    template <bool Dual, bool Moving>
+    struct AccSink;
+    // Sizes object o's window for its rectangle (rects_[o]) and walks its edges as placed in
+    // polys_ into it. With marks (a moving object) it also marks the pixels its edges touch
+    // (rows y0 .. y1 grow to hold them) and keeps no written bits; without (a still object,
+    // walked once) it keeps them. An object off the sensor is not walked (its window is empty).
     void walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
@@ -105,8 +109,7 @@ private:
     std::vector<double> lref_, ion_, ioff_;
     std::vector<float> con_, coff_;
     std::vector<std::int64_t> last_;
-    std::vector<double> acc_cov_, acc_int_;
-    std::vector<TermList> terms_;  // per object, its edge walk at the time being rendered
+    std::vector<ObjectAcc> acc_;  // per object, its edge walk at the time being rendered
     // Per object: its pieces' polygons at the time being rendered (polys_) and at time_us()
     // (prev_polys_), and the pixel rectangle it covers at the time being rendered.
     std::vector<std::vector<std::vector<Vec2>>> polys_, prev_polys_;
@@ -116,11 +119,11 @@ private:
     // the time being rendered (cur_marks_) and at time_us() (prev_marks_, kept from the step
     // that reached it), each with the range of rows [y0, y1] outside which it is all zero;
     // dirty_ is their union (valid over dirty_y0_ .. dirty_y1_), the pixels recomputed.
-    // written_: the columns of acc_cov_ / acc_int_ the edge accumulation wrote (all zero
-    // between renders).
-    std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, written_, zero_row_;
+    std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, zero_row_;
     int cur_y0_ = 0, cur_y1_ = -1, prev_y0_ = 0, prev_y1_ = -1, dirty_y0_ = 0, dirty_y1_ = -1;
-    std::vector<std::uint32_t> changed_;  // the dirty pixels whose next_ differs from cur_
+    std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
+    std::vector<std::uint32_t> changed_;  // its first changed_n_: the dirty pixels whose next_ differs from cur_
+    std::size_t changed_n_ = 0;
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
     double noise_rate_per_us_ = 0;
