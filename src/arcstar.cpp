@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "evcorner/cpu_paths.hpp"
+
 namespace evcorner {
 
 namespace {
@@ -50,11 +52,9 @@ Path choose() noexcept {
     const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
     const auto wanted = [forced](const char* name) { return forced == nullptr || std::strcmp(forced, name) == 0; };
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-    __builtin_cpu_init();
-    if (wanted("avx512") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
+    if (wanted("avx512") && cpu_runs_avx512())
         return {"avx512", detect_avx512};
-    if ((wanted("avx2") || wanted("avx512")) && __builtin_cpu_supports("avx2")) return {"avx2", detect_avx2};
+    if ((wanted("avx2") || wanted("avx512")) && cpu_runs_avx2()) return {"avx2", detect_avx2};
 #endif
     return {"portable", detect_portable};
 }

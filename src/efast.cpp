@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "evcorner/cpu_paths.hpp"
+
 namespace evcorner {
 
 namespace {
@@ -68,11 +70,9 @@ struct Path {
 std::vector<Path> available() {
     std::vector<Path> paths;
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
+    if (cpu_runs_avx512())
         paths.push_back({"avx512", detect_avx512});
-    if (__builtin_cpu_supports("avx2")) paths.push_back({"avx2", detect_avx2});
+    if (cpu_runs_avx2()) paths.push_back({"avx2", detect_avx2});
 #endif
     paths.push_back({"portable", detect_portable});
     return paths;

@@ -4,6 +4,8 @@
 #include <limits>
 #include <string>
 
+#include "evcorner/cpu_paths.hpp"
+
 namespace evcorner {
 
 namespace {
@@ -73,15 +75,14 @@ std::size_t first_invalid(std::span<const Event> events, const EventLimits& limi
 
 using Finder = std::size_t (*)(std::span<const Event>, const EventLimits&) noexcept;
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
 // flatten: the whole pass compiled for AVX2 here and nowhere else.
 [[gnu::target("avx2"), gnu::flatten]] std::size_t first_invalid_avx2(std::span<const Event> events,
                                                                       const EventLimits& limits) noexcept {
     return first_invalid<true>(events, limits);
 }
 Finder choose() noexcept {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") ? first_invalid_avx2 : first_invalid<false>;
+    return cpu_runs_avx2() ? first_invalid_avx2 : first_invalid<false>;
 }
 #else
 Finder choose() noexcept { return first_invalid<false>; }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "evcorner/circle.hpp"
+#include "evcorner/cpu_paths.hpp"
 #include "evcorner/harris_select.hpp"
 
 #if defined(__SSE2__)
@@ -294,11 +295,9 @@ Loop loop() noexcept {
         const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
         const auto wanted = [forced](const char* name) { return forced == nullptr || std::strcmp(forced, name) == 0; };
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-        __builtin_cpu_init();
-        if (wanted("avx512") && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
+        if (wanted("avx512") && cpu_runs_avx512())
             return static_cast<Loop>(run_avx512);
-        if ((wanted("avx2") || wanted("avx512")) && __builtin_cpu_supports("avx2")) return static_cast<Loop>(run_avx2);
+        if ((wanted("avx2") || wanted("avx512")) && cpu_runs_avx2()) return static_cast<Loop>(run_avx2);
 #endif
         return static_cast<Loop>(run_portable);
     }();

@@ -8,11 +8,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#define EVCORNER_NMS_X86 1
-#define EVCORNER_NMS_AVX512 "avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt,lzcnt"
-#endif
+#include "evcorner/cpu_paths.hpp"
 
 namespace evcorner {
 
@@ -39,7 +35,7 @@ bool window_portable(const std::int64_t* times, const std::int64_t* scores, std:
     return suppressed;
 }
 
-#ifdef EVCORNER_NMS_X86
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
 // Four cells per vector; the last chunk of a row masked (masked loads do not touch the
 // lanes left out, so nothing past the row's end is read).
 [[gnu::target("avx2")]] bool window_avx2(const std::int64_t* times, const std::int64_t* scores, std::size_t W, int x0,
@@ -63,7 +59,7 @@ bool window_portable(const std::int64_t* times, const std::int64_t* scores, std:
 }
 
 // Eight cells per vector (a whole row for radius <= 3).
-[[gnu::target(EVCORNER_NMS_AVX512)]] bool window_avx512(const std::int64_t* times,
+[[gnu::target(EVCORNER_AVX512_TARGET)]] bool window_avx512(const std::int64_t* times,
                                                                           const std::int64_t* scores, std::size_t W,
                                                                           int x0, int x1, int y0, int y1,
                                                                           std::int64_t oldest, double s) noexcept {
@@ -196,7 +192,7 @@ std::size_t filter_portable(AsyncNms& n, std::span<const Event> ev, std::span<st
                             std::span<const double> s) noexcept {
     return NmsPath::filter<window_portable>(n, ev, c, s);
 }
-#ifdef EVCORNER_NMS_X86
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
 [[gnu::target("avx2"), gnu::flatten]] bool keep_avx2(AsyncNms& n, const Event& e, double s) noexcept {
     return NmsPath::keep<window_avx2>(n, e, s);
 }
@@ -205,10 +201,10 @@ std::size_t filter_portable(AsyncNms& n, std::span<const Event> ev, std::span<st
                                                                std::span<const double> s) noexcept {
     return NmsPath::filter<window_avx2>(n, ev, c, s);
 }
-[[gnu::target(EVCORNER_NMS_AVX512), gnu::flatten]] bool keep_avx512(AsyncNms& n, const Event& e, double s) noexcept {
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] bool keep_avx512(AsyncNms& n, const Event& e, double s) noexcept {
     return NmsPath::keep<window_avx512>(n, e, s);
 }
-[[gnu::target(EVCORNER_NMS_AVX512), gnu::flatten]] std::size_t filter_avx512(AsyncNms& n, std::span<const Event> ev,
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t filter_avx512(AsyncNms& n, std::span<const Event> ev,
                                                                              std::span<std::uint8_t> c,
                                                                              std::span<const double> s) noexcept {
     return NmsPath::filter<window_avx512>(n, ev, c, s);
@@ -225,12 +221,10 @@ struct WindowPath {
 const std::vector<WindowPath>& window_paths() {
     static const std::vector<WindowPath> paths = [] {
         std::vector<WindowPath> p;
-#ifdef EVCORNER_NMS_X86
-        __builtin_cpu_init();
-        if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        if (cpu_runs_avx512())
             p.push_back({"avx512", keep_avx512, filter_avx512});
-        if (__builtin_cpu_supports("avx2")) p.push_back({"avx2", keep_avx2, filter_avx2});
+        if (cpu_runs_avx2()) p.push_back({"avx2", keep_avx2, filter_avx2});
 #endif
         p.push_back({"portable", keep_portable, filter_portable});
         return p;

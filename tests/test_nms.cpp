@@ -256,7 +256,8 @@ TEST(Nms, BatchLoopEqualsEventByEventOnEveryPath) {
                     for (std::size_t at = 0; at < events.size(); at += batch) {
                         const std::size_t n = std::min(batch, events.size() - at);
                         const auto ev = std::span<const Event>(events).subspan(at, n);
-                        ca += detect(a, ev, std::span<std::uint8_t>(fa).subspan(at, n), std::span<double>(sa).subspan(at, n));
+                        ca += detect(a, ev, std::span<std::uint8_t>(fa).subspan(at, n),
+                                     std::span<double>(sa).subspan(at, n));
                         cb += detect(b, ev, std::span<std::uint8_t>(fb).subspan(at, n));
                     }
                     EXPECT_EQ(ca, kept);
@@ -264,7 +265,9 @@ TEST(Nms, BatchLoopEqualsEventByEventOnEveryPath) {
                     for (std::size_t i = 0; i < events.size(); ++i) {
                         ASSERT_EQ(fa[i], want[i]) << "event " << i;
                         ASSERT_EQ(fb[i], want[i]) << "event " << i;
-                        if (want[i]) ASSERT_EQ(sa[i], want_score[i]) << "event " << i;
+                        if (want[i]) {
+                            ASSERT_EQ(sa[i], want_score[i]) << "event " << i;
+                        }
                     }
                 }
         }

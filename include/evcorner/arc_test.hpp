@@ -20,10 +20,7 @@
 #include <iterator>
 #include <utility>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#define EVCORNER_HAVE_AVX2_SEARCH 1
-#endif
+#include "evcorner/cpu_paths.hpp"
 
 namespace evcorner {
 
@@ -171,7 +168,6 @@ struct Avx2Search {
     }
 };
 
-#define EVCORNER_AVX512_TARGET "avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt,lzcnt"
 /// AVX-512 (F, VL, BW, DQ): each circle's whole arc test for all its arcs at once
 /// (circle16_fires, circle20_fires), by the definition: the arc of length L from pixel s
 /// fires iff min(t[s .. s+L-1]) > max(t[s+L .. s+N-1]). With the circle in vector

@@ -1,0 +1,38 @@
+#pragma once
+// evcorner's vector code paths (AVX2, AVX-512) on x86-64 with GCC or Clang: the
+// instruction sets each is compiled for, and whether this CPU runs it. A detector's batch
+// loop (and NMS's neighbourhood test) is compiled once per path (gnu::target) and chosen
+// at run time from these; the portable path runs everywhere.
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define EVCORNER_HAVE_AVX2_SEARCH 1
+/// The instruction sets every AVX-512 path is compiled for (any CPU with the four AVX-512
+/// subsets cpu_runs_avx512() asks for has the others).
+#define EVCORNER_AVX512_TARGET "avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt,lzcnt"
+#endif
+
+namespace evcorner {
+
+/// Whether this CPU runs the AVX-512 paths: AVX-512 F, VL, BW and DQ (false off x86-64).
+inline bool cpu_runs_avx512() noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+           __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+#else
+    return false;
+#endif
+}
+
+/// Whether this CPU runs the AVX2 paths (false off x86-64).
+inline bool cpu_runs_avx2() noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+#else
+    return false;
+#endif
+}
+
+}  // namespace evcorner
