@@ -25,7 +25,8 @@
 //
 // Suppressed<D> composes the stage with a scored detector D into a detector (the
 // Detector concept; scored too): the pipeline, --threads and the bindings run it as any
-// other. Its batch loop runs D's own scored batch loop, then the stage over the corners.
+// other. Its batch loop runs D's own scored batch loop, then the stage over the corners, a
+// chunk of kNmsChunk events at a time (each chunk's events and scores still in the cache).
 
 #include <algorithm>
 #include <cmath>
