@@ -84,13 +84,8 @@ const std::vector<Path>& paths() {
 }
 
 const Path& choice() noexcept {
-    static const Path& c = [] () -> const Path& {
-        // EVCORNER_EFAST_PATH=portable (or avx2, avx512) forces a path this CPU runs.
-        if (const char* forced = std::getenv("EVCORNER_EFAST_PATH"))
-            for (const Path& p : paths())
-                if (std::strcmp(forced, p.name) == 0) return p;
-        return paths().front();
-    }();
+    // EVCORNER_EFAST_PATH=portable (or avx2, avx512) forces a path this CPU runs.
+    static const Path& c = forced_or_fastest(paths(), "EVCORNER_EFAST_PATH");
     return c;
 }
 

@@ -233,13 +233,8 @@ const std::vector<WindowPath>& window_paths() {
 }
 
 const WindowPath& default_window_path() noexcept {
-    static const WindowPath& c = []() -> const WindowPath& {
-        // EVCORNER_NMS_PATH=portable (or avx2, avx512) forces a path this CPU runs.
-        if (const char* forced = std::getenv("EVCORNER_NMS_PATH"))
-            for (const WindowPath& p : window_paths())
-                if (std::strcmp(forced, p.name) == 0) return p;
-        return window_paths().front();
-    }();
+    // EVCORNER_NMS_PATH=portable (or avx2, avx512) forces a path this CPU runs.
+    static const WindowPath& c = forced_or_fastest(window_paths(), "EVCORNER_NMS_PATH");
     return c;
 }
 }  // namespace

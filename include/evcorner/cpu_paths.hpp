@@ -12,6 +12,10 @@
 #define EVCORNER_AVX512_TARGET "avx512f,avx512vl,avx512bw,avx512dq,avx2,bmi,bmi2,popcnt,lzcnt"
 #endif
 
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
 namespace evcorner {
 
 /// Whether this CPU runs the AVX-512 paths: AVX-512 F, VL, BW and DQ (false off x86-64).
@@ -33,6 +37,17 @@ inline bool cpu_runs_avx2() noexcept {
 #else
     return false;
 #endif
+}
+
+/// The path that environment variable `env` names (EVCORNER_EFAST_PATH=portable, ...) among
+/// `paths`, those this CPU runs, fastest first, each with a `name`; the fastest when `env`
+/// is unset or names none of them.
+template <class Path>
+const Path& forced_or_fastest(const std::vector<Path>& paths, const char* env) noexcept {
+    if (const char* forced = std::getenv(env))
+        for (const Path& p : paths)
+            if (std::strcmp(forced, p.name) == 0) return p;
+    return paths.front();
 }
 
 }  // namespace evcorner

@@ -16,6 +16,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "evcorner/cpu_paths.hpp"
+
 namespace evcorner::eval {
 
 void validate(const FeatureTrackParams& p) {
@@ -290,11 +292,8 @@ void mark_portable(const QuadrantView& q, std::size_t n, const Axis& a) noexcept
 std::vector<Kernels> available_kernels() {
     std::vector<Kernels> k;
 #ifdef EVCORNER_FT_SIMD_PATHS
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq"))
-        k.push_back({"avx512", count_avx512, count_weighted_avx512, mark_avx512});
-    if (__builtin_cpu_supports("avx2")) k.push_back({"avx2", count_avx2, count_weighted_avx2, mark_avx2});
+    if (cpu_runs_avx512()) k.push_back({"avx512", count_avx512, count_weighted_avx512, mark_avx512});
+    if (cpu_runs_avx2()) k.push_back({"avx2", count_avx2, count_weighted_avx2, mark_avx2});
 #endif
     k.push_back({"portable", count_portable, count_weighted_portable, mark_portable});
     return k;
@@ -306,13 +305,8 @@ const std::vector<Kernels>& all_kernels() {
 }
 
 const Kernels& chosen_kernels() noexcept {
-    static const Kernels& c = []() -> const Kernels& {
-        // EVCORNER_LABEL_PATH=portable (or avx2, avx512) forces a path this CPU runs.
-        if (const char* forced = std::getenv("EVCORNER_LABEL_PATH"))
-            for (const Kernels& k : all_kernels())
-                if (std::strcmp(forced, k.name) == 0) return k;
-        return all_kernels().front();
-    }();
+    // EVCORNER_LABEL_PATH=portable (or avx2, avx512) forces a path this CPU runs.
+    static const Kernels& c = forced_or_fastest(all_kernels(), "EVCORNER_LABEL_PATH");
     return c;
 }
 
