@@ -11,7 +11,12 @@
 // FA-Harris's 50 ms filter), every copy meets the detectors' time windows as the file's own
 // start does: cold and replayed passes then do the same work per event, and cold/replayed
 // measures what a cold start costs (caches, first touch), not a filter rejecting more events
-// of a copy that follows its predecessor within 50 ms. Per detector:
+// of a copy that follows its predecessor within 50 ms. The identical copies of a short file
+// repeat one sequence of events, which the CPU's branch predictors partly learn: the replayed
+// figure of a 30 000-event file is faster than a continuous stream of the same kind, and its
+// cold/replayed larger than the cold start costs (docs/performance.md, "What a replay
+// measures"; bench/bench_warmup.cpp measures the cold start on a continuous recording).
+// Per detector:
 //  - throughput: --repeat passes over the whole stream, each with a freshly built detector
 //    (construction not timed), timed with steady_clock around detect() alone; ns/event
 //    median, min and max over the passes; max event rate = 1e9 / median ns/event.
@@ -648,7 +653,11 @@ void add_bench_command(CLI::App& app) {
         "over it, one thread. Prints ns/event (replayed median, min, max; cold median and\n"
         "cold/replayed), the maximum sustainable event rate, per-event latency percentiles\n"
         "(p50, p99, p99.9), detector memory, the CPU model and build flags; with\n"
-        "--yardstick also the cold speed as a multiple of a plain eFAST timed in the same run.");
+        "--yardstick also the cold speed as a multiple of a plain eFAST timed in the same run.\n"
+        "Note: a short file replayed as identical copies is partly learned by the CPU's branch\n"
+        "predictors, so its replayed figure is faster than a continuous stream of the same kind\n"
+        "(docs/performance.md, \"What a replay measures\"; bench/bench_warmup.cpp measures the\n"
+        "cold start on a continuous recording instead).");
     cmd->add_option("FILE", o->inputs, "Event files (any format evcorner reads)")->required();
     cmd->add_option("-d,--detectors", o->detectors,
                     "Comma-separated detectors to run, or all [default: all registered, each with its defaults "
