@@ -17,10 +17,17 @@
 //   first/learned  how much of a cold/replayed factor over a file of --chunk events comes
 //           from the CPU learning the repeated events, not from the detector's state
 //
+// --images: instead, what the CPU learns. One detector runs over 40 copies of the first chunk
+// (each shifted in time 100 ms past the previous one), the copies cycling through K of the
+// sensor's mirror and polarity images (K = 1: identical copies; 2p: the file and its
+// polarity-swapped image, which has the same branch outcomes in the other plane of memory;
+// 2x: the file and its x-mirror; 4: the four mirrors; 8: the four mirrors, each also
+// polarity-swapped); printed: the median ns/event of copies 9-40.
+//
 // Each figure is the median over --rounds rounds (each round: the detectors in turn, a fresh
 // detector each). Thread CPU time; one thread. Files with fewer than 4 chunks are skipped.
 //
-// usage: bench_warmup [--chunk N] [--rounds K] [-d det1,det2,...] [FILE...]
+// usage: bench_warmup [--chunk N] [--rounds K] [--images] [-d det1,det2,...] [FILE...]
 //   default: every registered detector on the real recordings of ../shared/data that hold
 //   at least 4 chunks (IMU_rotDisk, IMU_translBoxes of the DAVIS240C set).
 
@@ -34,6 +41,7 @@
 #include <exception>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "evcorner/detector.hpp"
@@ -102,6 +110,40 @@ Figures round(const std::string& name, SensorSize sensor, std::span<const Event>
     return f;
 }
 
+/// The image of `e` under symmetry v: bit 0 mirrors x, bit 1 mirrors y, bit 2 swaps polarity.
+Event image(Event e, unsigned v, SensorSize s) {
+    if (v & 1u) e.x = static_cast<std::uint16_t>(s.width - 1 - e.x);
+    if (v & 2u) e.y = static_cast<std::uint16_t>(s.height - 1 - e.y);
+    if (v & 4u) e.p = static_cast<std::uint8_t>(e.p ? 0 : 1);
+    return e;
+}
+
+/// One detector over 40 copies of `head` cycling through `cycle`'s images; the median
+/// ns/event of copies 9-40.
+double images_round(const std::string& name, SensorSize sensor, std::span<const Event> head,
+                    const std::vector<unsigned>& cycle) {
+    const std::int64_t shift = head.back().t - head.front().t + 1 + 100'000;
+    std::vector<Event> copy(head.size());
+    std::vector<std::uint8_t> flags(head.size());
+    std::vector<double> ns;
+    AnyDetector any = make_detector(name, sensor);
+    std::visit(
+        [&](auto& det) {
+            for (int r = 0; r < 40; ++r) {
+                const unsigned v = cycle[static_cast<std::size_t>(r) % cycle.size()];
+                for (std::size_t i = 0; i < head.size(); ++i) {
+                    copy[i] = image(head[i], v, sensor);
+                    copy[i].t += static_cast<std::int64_t>(r) * shift;
+                }
+                const double t0 = cpu_ns();
+                detect(det, std::span<const Event>(copy), flags);
+                if (r >= 8) ns.push_back((cpu_ns() - t0) / static_cast<double>(head.size()));
+            }
+        },
+        any);
+    return median(ns);
+}
+
 std::vector<std::string> split(const std::string& s) {
     std::vector<std::string> out;
     std::size_t a = 0;
@@ -116,6 +158,7 @@ std::vector<std::string> split(const std::string& s) {
 int run(int argc, char** argv) {
     std::size_t chunk = 30000;
     int rounds = 5;
+    bool images = false;
     std::vector<std::string> detectors, files;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -124,8 +167,10 @@ int run(int argc, char** argv) {
             if (a == "--chunk") chunk = std::stoul(v);
             if (a == "--rounds") rounds = std::stoi(v);
             if (a == "-d") detectors = split(v);
+        } else if (a == "--images") {
+            images = true;
         } else if (a == "-h" || a == "--help") {
-            std::puts("usage: bench_warmup [--chunk N] [--rounds K] [-d det1,det2,...] [FILE...]");
+            std::puts("usage: bench_warmup [--chunk N] [--rounds K] [--images] [-d det1,det2,...] [FILE...]");
             return 0;
         } else {
             files.push_back(a);
@@ -136,12 +181,38 @@ int run(int argc, char** argv) {
         for (const DetectorInfo& d : detector_infos()) detectors.emplace_back(d.name);
     if (files.empty())
         for (const auto& f : bench::real_240x180_files(std::filesystem::path(EVCORNER_SHARED_DIR) / "data"))
-            if (!f.ecd) files.push_back(f.events.string());
+            if (images ? f.name == "shapes_rotation" : !f.ecd) files.push_back(f.events.string());
     if (files.empty()) {
         std::puts("bench_warmup: no files given and ../shared/data is absent: nothing to measure");
         return 0;
     }
     fmt::print("chunk {} events, {} rounds, thread CPU time; figures are medians over the rounds\n", chunk, rounds);
+    if (images) {
+        const std::vector<std::pair<const char*, std::vector<unsigned>>> cycles{
+            {"1", {0}}, {"2p", {0, 4}}, {"2x", {0, 1}}, {"4", {0, 1, 2, 3}}, {"8", {0, 1, 2, 3, 4, 5, 6, 7}}};
+        fmt::print("ns/event of copies 9-40, the copies cycling through K images of the first chunk\n");
+        fmt::print("{:<24} {:<13}", "file", "detector");
+        for (const auto& c : cycles) fmt::print(" {:>7}", std::string("K=") + c.first);
+        fmt::print("\n");
+        for (const std::string& file : files) {
+            const auto reader = io::open_event_reader(file);
+            const std::vector<Event> events = io::read_all_events(*reader);
+            const SensorSize sensor = reader->sensor().value_or(kDavis240);
+            const std::span<const Event> head = std::span<const Event>(events).first(std::min(chunk, events.size()));
+            const std::string name = std::filesystem::path(file).parent_path().filename().string();
+            for (const std::string& d : detectors) {
+                fmt::print("{:<24} {:<13}", name, d);
+                for (const auto& c : cycles) {
+                    std::vector<double> v;
+                    for (int r = 0; r < rounds; ++r) v.push_back(images_round(d, sensor, head, c.second));
+                    fmt::print(" {:>7.1f}", median(v));
+                }
+                fmt::print("\n");
+                std::fflush(stdout);
+            }
+        }
+        return 0;
+    }
     fmt::print("{:<20} {:<13} {:>6} {:>9} {:>9} {:>10} {:>9} {:>13}\n", "file", "detector", "chunks", "first ns",
                "rest ns", "first/rest", "learned", "first/learned");
     for (const std::string& file : files) {
