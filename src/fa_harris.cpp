@@ -57,36 +57,6 @@ std::uint64_t FaHarris::state_bytes(SensorSize size, const Params& params, int) 
     return static_cast<std::uint64_t>(size.pixels()) * sizeof(ArcStarLatest) + 2 * framed * 2 * sizeof(std::int64_t);
 }
 
-template <class Search>
-bool FaHarris::process_with(const Event& e) noexcept {
-    score_ = kNoScore;
-    // (1) Border first: such an event changes no state at all.
-    if (e.x < kCircleMargin || e.x >= size_.width - kCircleMargin || e.y < kCircleMargin ||
-        e.y >= size_.height - kCircleMargin)
-        return false;
-    // (2) The Arc* filter; a passing event writes the filtered SAE and its arrival number.
-    const int p = e.p & 1;
-    const std::int64_t st = Sae::stored(e.t);
-    ArcStarLatest& l = latest_[static_cast<std::size_t>(e.y) * static_cast<std::size_t>(size_.width) + e.x];
-    const bool pass = !params_.filter | arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], params_.filter_us, params_.zero_init);
-    l.t[p] = st;
-    if (!pass) return false;
-    const std::size_t i = plane(p) + index(e.x, e.y);
-    std::int64_t* const centre = sae_.data() + i;
-    *centre = st;
-    arrival_[i] = ++arrivals_;
-    in_time_order_ &= st >= newest_;
-    newest_ = std::max(newest_, st);
-    // (3) The Arc* candidate test (the AVX-512 path reads *centre as the event's time).
-    if (!ArcStarCircles(static_cast<std::ptrdiff_t>(stride_))
-             .pass<Search, ArcStar::kArc3Min, ArcStar::kArc3Max, ArcStar::kArc4Min, ArcStar::kArc4Max>(
-                 centre, params_.minority_only))
-        return false;
-    // (4) Harris on the nl newest filtered pixels of the window.
-    score_ = refine(p, e.x, e.y);
-    return score_ > params_.threshold;  // false for NaN
-}
-
 namespace {
 
 // Boundary cells up to this many are ranked by all pairs, more by std::nth_element.
@@ -233,39 +203,119 @@ double newest_patch_score(const std::int64_t* times, const std::uint64_t* seqs, 
 
 }  // namespace
 
-double FaHarris::refine(int p, int x, int y) const noexcept {
+double FaHarris::refine(int p, int x, int y, std::uint64_t now, std::int64_t newest,
+                        bool in_time_order) const noexcept {
     const int r = params_.window / 2;
     const std::size_t first = plane(p) + index(x - r, y - r);
     const std::uint64_t* const seqs = arrival_.data() + first;
-    if (in_time_order_) {
+    if (in_time_order) {
         // Every filtered write came in time order, so a later arrival number is a later
         // time or the same time and a later arrival: the nl newest are the nl largest
         // arrival numbers (0 = never passed), as adaptive Harris selects them.
         std::uint16_t rows[HarrisScorer::kMaxWindow];
-        if (!harris_select_newest(path_, seqs, stride_, params_.window, arrivals_, params_.nl, rows))
+        if (!harris_select_newest(path_, seqs, stride_, params_.window, now, params_.nl, rows))
             return kNoScore;  // fewer than nl filtered pixels in the window
         return patch_score(scorer_, path_, params_.window, rows);
     }
     const std::int64_t* const times = sae_.data() + first;
     if (params_.window == 9)
-        return newest_patch_score<9>(times, seqs, stride_, newest_, 9, params_.nl, scorer_, path_);
-    return newest_patch_score<0>(times, seqs, stride_, newest_, params_.window, params_.nl, scorer_, path_);
+        return newest_patch_score<9>(times, seqs, stride_, newest, 9, params_.nl, scorer_, path_);
+    return newest_patch_score<0>(times, seqs, stride_, newest, params_.window, params_.nl, scorer_, path_);
 }
 
-bool FaHarris::process_unchecked(const Event& e) noexcept { return process_with<ScalarSearch>(e); }
-
+// The per-event work on locals: the state's pointers, sizes and counters are copied out of
+// the detector once per call and written back at its end, so that the loop keeps them in
+// registers (a member would be reloaded after every store into the planes, which may alias
+// it as far as the compiler knows). Published: filter on and never-fired passes (the
+// defaults), as compile-time constants.
 struct FaHarrisLoops {
-    template <class Search>
-    static std::size_t run(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+    struct Locals {
+        ArcStarLatest* latest;
+        std::int64_t* sae;       // plane 0 at pixel (0, 0) (past the frame)
+        std::uint64_t* arrival;  // likewise
+        std::size_t stride, plane_size;
+        int width, height;
+        std::int64_t filter_us;
+        bool filter, zero_init, minority_only;
+        double threshold;
+        std::uint64_t arrivals;
+        std::int64_t newest;
+        bool in_time_order;
+        double score;
+
+        static Locals of(FaHarris& d) noexcept {
+            const std::size_t origin = d.index(0, 0);
+            return {d.latest_.data(), d.sae_.data() + origin, d.arrival_.data() + origin, d.stride_, d.plane_size_,
+                    d.size_.width, d.size_.height, d.params_.filter_us, d.params_.filter, d.params_.zero_init,
+                    d.params_.minority_only, d.params_.threshold, d.arrivals_, d.newest_, d.in_time_order_, d.score_};
+        }
+        void store(FaHarris& d) const noexcept {
+            d.arrivals_ = arrivals;
+            d.newest_ = newest;
+            d.in_time_order_ = in_time_order;
+            d.score_ = score;
+        }
+    };
+
+    template <class Search, bool Published>
+    static bool step(const FaHarris& det, Locals& s, const Event& e) noexcept {
+        s.score = kNoScore;
+        // (1) Border first: such an event changes no state at all.
+        if (e.x < kCircleMargin || e.x >= s.width - kCircleMargin || e.y < kCircleMargin ||
+            e.y >= s.height - kCircleMargin)
+            return false;
+        // (2) The Arc* filter; a passing event writes the filtered SAE and its arrival number.
+        const int p = e.p & 1;
+        const std::int64_t st = Sae::stored(e.t);
+        ArcStarLatest& l = s.latest[static_cast<std::size_t>(e.y) * static_cast<std::size_t>(s.width) + e.x];
+        const bool pass = !(Published || s.filter) |
+                          arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], s.filter_us, !Published && s.zero_init);
+        l.t[p] = st;
+        if (!pass) return false;
+        const std::size_t i = static_cast<std::size_t>(p) * s.plane_size + static_cast<std::size_t>(e.y) * s.stride + e.x;
+        std::int64_t* const centre = s.sae + i;
+        *centre = st;
+        s.arrival[i] = ++s.arrivals;
+        s.in_time_order &= st >= s.newest;
+        s.newest = std::max(s.newest, st);
+        // (3) The Arc* candidate test (the AVX-512 path reads *centre as the event's time).
+        if (!ArcStarCircles(static_cast<std::ptrdiff_t>(s.stride))
+                 .pass<Search, ArcStar::kArc3Min, ArcStar::kArc3Max, ArcStar::kArc4Min, ArcStar::kArc4Max>(
+                     centre, s.minority_only))
+            return false;
+        // (4) Harris on the nl newest filtered pixels of the window.
+        s.score = det.refine(p, e.x, e.y, s.arrivals, s.newest, s.in_time_order);
+        return s.score > s.threshold;  // false for NaN
+    }
+
+    template <class Search, bool Published>
+    static std::size_t loop(const FaHarris& det, Locals& s, std::span<const Event> events,
+                            std::span<std::uint8_t> is_corner) noexcept {
         std::size_t corners = 0;
         for (std::size_t i = 0; i < events.size(); ++i) {
-            const bool c = det.process_with<Search>(events[i]);
+            const bool c = step<Search, Published>(det, s, events[i]);
             is_corner[i] = static_cast<std::uint8_t>(c);
             corners += c;
         }
         return corners;
     }
+
+    template <class Search>
+    static std::size_t run(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+        Locals s = Locals::of(det);
+        const std::size_t corners = s.filter && !s.zero_init ? loop<Search, true>(det, s, events, is_corner)
+                                                             : loop<Search, false>(det, s, events, is_corner);
+        s.store(det);
+        return corners;
+    }
 };
+
+bool FaHarris::process_unchecked(const Event& e) noexcept {
+    FaHarrisLoops::Locals s = FaHarrisLoops::Locals::of(*this);
+    const bool c = FaHarrisLoops::step<ScalarSearch, false>(*this, s, e);
+    s.store(*this);
+    return c;
+}
 
 namespace {
 

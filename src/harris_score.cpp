@@ -151,25 +151,40 @@ constexpr RunTables kRuns = make_run_tables();
         yy[r] = _mm256_mullo_epi32(iy, iy);
     }
     const __m256i mirror = _mm256_setr_epi32(4, 3, 5, 5, 5, 5, 5, 5);  // lane 5 is zero
-    alignas(16) std::int32_t f[3][3][4];  // [quantity][|row - 2|: 2, 1, 0][lane]
+    // f[q][a]: lanes 0, 1, 2 = the sums at |column - 2| = 2, 1, 0 of quantity q (Ix^2, Ix Iy,
+    // Iy^2) over the rows at |row - 2| = 2 - a; lane 3 zero.
+    __m128i f[3][3];
     const __m256i* const p[3] = {xx, xy, yy};
     for (int q = 0; q < 3; ++q) {
         const __m256i folded[3] = {_mm256_add_epi32(p[q][0], p[q][4]), _mm256_add_epi32(p[q][1], p[q][3]), p[q][2]};
         for (int a = 0; a < 3; ++a)
-            _mm_store_si128(reinterpret_cast<__m128i*>(f[q][a]),
-                            _mm256_castsi256_si128(_mm256_add_epi32(folded[a], _mm256_permutevar8x32_epi32(folded[a], mirror))));
+            f[q][a] = _mm256_castsi256_si128(_mm256_add_epi32(folded[a], _mm256_permutevar8x32_epi32(folded[a], mirror)));
     }
-    // Weight classes by squared distance 0, 1, 2, 4, 5, 8 (score9's kClass): f[q][2 - ar][2 - ac].
-    std::int64_t sums[3][6];
-    for (int q = 0; q < 3; ++q) {
-        sums[q][0] = f[q][2][2];
-        sums[q][1] = std::int64_t{f[q][2][1]} + f[q][1][2];
-        sums[q][2] = f[q][1][1];
-        sums[q][3] = std::int64_t{f[q][2][0]} + f[q][0][2];
-        sums[q][4] = std::int64_t{f[q][1][0]} + f[q][0][1];
-        sums[q][5] = f[q][0][0];
+    // Transposed: t[a][c] = (Ix^2, Ix Iy, Iy^2, 0) at (|row - 2|, |column - 2|) = (2 - a, 2 - c).
+    __m128i t[3][3];
+    const __m128i zero = _mm_setzero_si128();
+    for (int a = 0; a < 3; ++a) {
+        const __m128i lo01 = _mm_unpacklo_epi32(f[0][a], f[1][a]);  // q0c0 q1c0 q0c1 q1c1
+        const __m128i hi01 = _mm_unpackhi_epi32(f[0][a], f[1][a]);  // q0c2 q1c2 0 0
+        const __m128i lo2 = _mm_unpacklo_epi32(f[2][a], zero);      // q2c0 0 q2c1 0
+        const __m128i hi2 = _mm_unpackhi_epi32(f[2][a], zero);      // q2c2 0 0 0
+        t[a][0] = _mm_unpacklo_epi64(lo01, lo2);
+        t[a][1] = _mm_unpackhi_epi64(lo01, lo2);
+        t[a][2] = _mm_unpacklo_epi64(hi01, hi2);
     }
-    return weighted9(sums[0], sums[1], sums[2]);
+    // The six weight classes (score9's kClass, squared distance 0, 1, 2, 4, 5, 8), the three
+    // quantities side by side as exact int32 sums, weighted in score9's order (no fused
+    // multiply-add: the same roundings as weighted9).
+    const __m128i classes[6] = {t[2][2], _mm_add_epi32(t[2][1], t[1][2]), t[1][1],
+                                _mm_add_epi32(t[2][0], t[0][2]), _mm_add_epi32(t[1][0], t[0][1]), t[0][0]};
+    __m256d acc = _mm256_setzero_pd();
+    for (int k = 0; k < 6; ++k)
+        acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_set1_pd(h9_[k]), _mm256_cvtepi32_pd(classes[k])));
+    alignas(32) double abc[4];
+    _mm256_store_pd(abc, acc);
+    constexpr double kScale2 = kHarrisKernelScale * kHarrisKernelScale;
+    const double a = abc[0] / kScale2, b = abc[1] / kScale2, cc = abc[2] / kScale2;
+    return a * cc - b * b - k_ * (a + cc) * (a + cc);
 }
 #else
 double HarrisScorer::score9_avx2(const std::uint16_t* rows) const noexcept { return score(rows); }

@@ -38,6 +38,8 @@ const Variant kVariants[] = {
     {"no_filter", {.filter = false}, 3, 0},
     {"minority_only", {.minority_only = true}, 2000, 60000},
     {"short_window_ties", {.filter_us = 30}, 20, 100},
+    // The filter on, not the published one (the batch loop's run-time parameter branch).
+    {"zero_init", {.zero_init = true}, 2000, 60000},
     {"window7_nl20", {.window = 7, .nl = 20}, 2000, 60000},
     {"window13_nl40_k06", {.filter = false, .window = 13, .nl = 40, .k = 0.06}, 3, 0},
     {"threshold0", {.filter = false, .threshold = 0.0}, 3, 0},

@@ -84,16 +84,17 @@ public:
     }
 
 private:
-    friend struct FaHarrisLoops;  // fa_harris.cpp: the batch loops of detect()
-    // process_unchecked() with a chosen newest-pixel search (arc_test.hpp).
-    template <class Search>
-    bool process_with(const Event& e) noexcept;
+    friend struct FaHarrisLoops;  // fa_harris.cpp: the per-event step and the batch loops of detect()
     [[nodiscard]] std::size_t index(int x, int y) const noexcept {
         return (static_cast<std::size_t>(y) + static_cast<std::size_t>(pad_)) * stride_ + static_cast<std::size_t>(x) +
                static_cast<std::size_t>(pad_);
     }
     [[nodiscard]] std::size_t plane(int p) const noexcept { return static_cast<std::size_t>(p & 1) * plane_size_; }
-    [[nodiscard]] double refine(int p, int x, int y) const noexcept;
+    // The Harris score of the window of (x, y), polarity p, the filtered SAE holding `now`
+    // arrivals, its newest time `newest`, `in_time_order` as in_time_order_ (kNoScore for
+    // fewer than nl filtered pixels).
+    [[nodiscard]] double refine(int p, int x, int y, std::uint64_t now, std::int64_t newest,
+                                bool in_time_order) const noexcept;
 
     Params params_;
     HarrisScorer scorer_;
