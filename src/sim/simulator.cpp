@@ -5,10 +5,12 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <set>
 #include <stdexcept>
 #include <string>
 
+#include "evcorner/sim/coverage.hpp"
 #include "evcorner/sim/coverage_walk.hpp"
 #include "evcorner/sim/motion.hpp"
 #include "evcorner/sim/texture.hpp"
@@ -22,6 +24,17 @@ constexpr double kSnap = 1e-12;
 // Largest move of any vertex in one step, px (mark_edges needs less than 1).
 constexpr double kMaxMove = 0.75;
 constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
+// A step's instants within it are keys of this many bits (Simulator::key_time).
+constexpr int kKeyBits = 48;
+constexpr std::uint64_t kKeyEnd = std::uint64_t{1} << kKeyBits;
+// A crossing's interpolated time is settled when halving its interval moves it by at most
+// this times step_fraction, us.
+constexpr double kCrossingTolPerFraction = 10.0;
+// A step (a render of the whole image) is at most this many max_step_us long; a pixel's own
+// samples within it follow the step fraction, and a crossing is interpolated over at most
+// max_step_us.
+constexpr double kCoarseSteps = 1.0;
+
 
 // Horizontal edges are widened by this much (px) when marking the pixels they touch, so that
 // rounding never leaves out a pixel one grazes (an extra pixel costs only time).
@@ -117,6 +130,15 @@ Simulator::Simulator(Scene scene)
         ioff_[i] = std::exp(lref_[i] - coff_[i]) - kLogEps;
     }
     last_.assign(n, INT64_MIN / 2);
+
+    piece_first_.assign(1, 0);
+    object_first_piece_.assign(1, 0);
+    for (const Object& obj : scene_.objects) {
+        for (const Piece& piece : obj.pieces) piece_first_.push_back(piece_first_.back() + piece.polygon.size());
+        object_first_piece_.push_back(object_first_piece_.back() + obj.pieces.size());
+    }
+    limit_ = scene_.simulation.step_fraction * cam.contrast;
+    crossing_tol_us_ = kCrossingTolPerFraction * scene_.simulation.step_fraction;
 
     const double noise_rate = cam.noise_hz * static_cast<double>(n) + cam.hot_pixel_hz * cam.hot_pixels;
     noise_rate_per_us_ = noise_rate / 1e6;
@@ -277,7 +299,7 @@ void Simulator::walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y
     }
 }
 
-double Simulator::render(bool all_rows) {
+void Simulator::render(bool all_rows) {
     if (all_rows) {
         for (int y = 0; y < h_; ++y) set_range(row_bits(dirty_, y), 0, w_ - 1);
         dirty_y0_ = 0;
@@ -395,29 +417,22 @@ double Simulator::render(bool all_rows) {
             }
         }
     }
-    // The dirty pixels that changed, and max |dL| over them, bounded by |dI| / (eps + min I)
-    // (log is concave).
+    // The dirty pixels that changed.
     changed_.resize(cur_.size());  // room for every pixel (only the first nc are kept)
     std::uint32_t* ch = changed_.data();
     std::size_t nc = 0;
-    double worst = 0;
     for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
         const std::uint64_t* d = row_bits(dirty_, y);
         const std::size_t base = static_cast<std::size_t>(y) * w;
         for (std::size_t k = 0; k < words_; ++k)
             for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
                 const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                const double a = cur_[i], b = next_[i];
-                // Without branches: every dirty pixel's index is written, kept when it
-                // changed; an unchanged one has quotient 0.
+                // Without branches: every dirty pixel's index is written, kept when it changed.
                 ch[nc] = static_cast<std::uint32_t>(i);
-                nc += a != b ? 1 : 0;
-                const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
-                worst = std::max(worst, d / den);
+                nc += cur_[i] != next_[i] ? 1 : 0;
             }
     }
     changed_n_ = nc;
-    return all_rows ? 0 : worst;
 }
 
 double Simulator::max_displacement() const noexcept {
@@ -433,11 +448,123 @@ double Simulator::max_displacement() const noexcept {
     return worst;
 }
 
-void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
-    const double dt = t1 - t0;
+double Simulator::key_time(std::uint64_t key) const noexcept {
+    return key == kKeyEnd ? step_t0_ + step_len_ : step_t0_ + step_len_ * (static_cast<double>(key) * (1.0 / static_cast<double>(kKeyEnd)));
+}
+
+const Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
+    const std::uint64_t tag = key | (static_cast<std::uint64_t>(o) << (kKeyBits + 2));
+    auto slot_of = [this](std::uint64_t t) {
+        const std::size_t mask = slot_tag_.size() - 1;
+        std::size_t i = static_cast<std::size_t>((t * 0x9E3779B97F4A7C15ull) >> 40) & mask;
+        while (slot_tag_[i] != 0 && slot_tag_[i] != t + 1) i = (i + 1) & mask;
+        return i;
+    };
+    std::size_t i = slot_of(tag);
+    if (slot_tag_[i] != 0) return places_[slot_place_[i]];
+    if (2 * (places_n_ + 1) > slot_tag_.size()) {  // keep the table at most half full
+        slot_tag_.assign(2 * slot_tag_.size(), 0);
+        slot_place_.resize(slot_tag_.size());
+        slots_used_.clear();
+        for (std::size_t j = 0; j < places_n_; ++j) {
+            const std::size_t s = slot_of(places_[j].tag);
+            slot_tag_[s] = places_[j].tag + 1;
+            slot_place_[s] = static_cast<std::uint32_t>(j);
+            slots_used_.push_back(static_cast<std::uint32_t>(s));
+        }
+        i = slot_of(tag);
+    }
+    slot_tag_[i] = tag + 1;
+    slot_place_[i] = static_cast<std::uint32_t>(places_n_);
+    slots_used_.push_back(static_cast<std::uint32_t>(i));
+    if (places_.size() <= places_n_) places_.resize(places_n_ + 1);
+    Placement& pl = places_[places_n_++];
+    pl.tag = tag;
+    const Object& obj = scene_.objects[o];
+    const std::size_t k0 = object_first_piece_[o], first = piece_first_[k0];
+    pl.v.resize(piece_first_[object_first_piece_[o + 1]] - first);
+    pl.piece.resize(obj.pieces.size());
+    const Pose pose(obj.motion, key_time(key) / 1e6, scene_.duration_s);
+    Vec2* dst = pl.v.data();
+    for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
+        Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
+        for (const Vec2& p0 : obj.pieces[k].polygon) {
+            const Vec2 q = pose.apply(p0);
+            *dst++ = q;
+            b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
+        }
+        pl.piece[k] = b;
+    }
+    return pl;
+}
+
+// The same compositing as render(), for one pixel, with each piece's coverage from its edges.
+double Simulator::sample(std::size_t p, std::uint64_t key) {
+    ++stats_.pixel_samples;
+    const std::size_t w = static_cast<std::size_t>(w_);
+    const int x = static_cast<int>(p % w), y = static_cast<int>(p / w);
+    const double x0 = x, x1 = x + 1.0, y0 = y, y1 = y + 1.0;
+    auto outside = [&](const Box& b) { return b.x1 <= x0 || b.x0 >= x1 || b.y1 <= y0 || b.y0 >= y1; };
+    double v = bg_[p];
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
+        if (outside(step_box_[o])) continue;
+        const Placement& pl = placement(o, key);
+        const Object& obj = scene_.objects[o];
+        const bool multi = obj.pieces.size() > 1;
+        const std::size_t first = piece_first_[object_first_piece_[o]];
+        double b = 0, s = 0;
+        for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
+            if (outside(pl.piece[k])) continue;
+            const std::size_t g = object_first_piece_[o] + k;
+            const double c = pixel_coverage(
+                std::span<const Vec2>(pl.v.data() + (piece_first_[g] - first), piece_first_[g + 1] - piece_first_[g]), x, y);
+            b += c;
+            if (multi) s += c * obj.pieces[k].intensity;
+        }
+        if (b <= kSnap) continue;
+        const double bc = b >= 1.0 - kSnap ? 1.0 : b;
+        v = v * (1.0 - bc) + (multi ? s : bc * obj.pieces[0].intensity);
+    }
+    return v;
+}
+
+void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double a, double b, bool settled,
+                       std::vector<Event>& ev) {
+    const double ta = key_time(ka), tb = key_time(kb);
+    const double q = std::abs(a - b) / (kLogEps + std::min(a, b));
+    const bool splittable = tb - ta > scene_.simulation.min_step_us && kb - ka >= 2;
+    const bool crosses = b > a ? b >= ion_[p] : b < a && b <= ioff_[p];
+    if (splittable && (q > limit_ || (crosses && tb - ta > scene_.simulation.max_step_us))) {
+        // Halved: each part checked again.
+        const std::uint64_t km = ka + (kb - ka) / 2;
+        const double m = sample(p, km);
+        refine(p, ka, km, a, m, false, ev);
+        refine(p, km, kb, m, b, false, ev);
+        return;
+    }
+    if (crosses && !settled && splittable) {
+        // I is taken as linear in the interval; the midpoint tells how far the crossing's time
+        // moves when the interval is halved. Settled within the tolerance, the halves are kept.
+        const std::uint64_t km = ka + (kb - ka) / 2;
+        const double m = sample(p, km), tm = key_time(km);
+        const double level = b > a ? ion_[p] : ioff_[p];
+        const double whole = ta + (level - a) / (b - a) * (tb - ta);
+        const bool first_half = b > a ? m >= level : m <= level;
+        const double halved = first_half ? ta + (level - a) / (m - a) * (tm - ta) : tm + (level - m) / (b - m) * (tb - tm);
+        const bool ok = std::abs(whole - halved) <= crossing_tol_us_;
+        refine(p, ka, km, a, m, ok, ev);
+        refine(p, km, kb, m, b, ok, ev);
+        return;
+    }
+    stats_.max_step_change = std::max(stats_.max_step_change, q / scene_.camera.contrast);
+    if (crosses) cross(p, ta, tb, a, b, ev);
+}
+
+void Simulator::cross(std::size_t p, double ta, double tb, double a, double b, std::vector<Event>& ev) {
+    const double dt = tb - ta;
     const double refractory = scene_.camera.refractory_us;
     const std::size_t w = static_cast<std::size_t>(w_);
-    auto emit = [&](std::size_t p, double tc, std::uint8_t pol) {
+    auto emit = [&](double tc, std::uint8_t pol) {
         const std::int64_t ts = std::max<std::int64_t>(1, std::llround(tc));
         if (refractory > 0 && static_cast<double>(ts - last_[p]) < refractory) {
             ++stats_.refractory;
@@ -446,28 +573,61 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         last_[p] = ts;
         ev.push_back({ts, static_cast<std::uint16_t>(p % w), static_cast<std::uint16_t>(p / w), pol});
     };
+    if (b > a) {
+        do {
+            emit(ta + (ion_[p] - a) / (b - a) * dt, 1);
+            lref_[p] += con_[p];
+            ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+        } while (b >= ion_[p]);
+        ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;  // only the last reference's is needed
+    } else {
+        do {
+            emit(ta + (ioff_[p] - a) / (b - a) * dt, 0);
+            lref_[p] -= coff_[p];
+            ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
+        } while (b <= ioff_[p]);
+        ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+    }
+}
+
+// Each changed pixel from its value at t0 to its value at t1, sampled on its own within the
+// step where its |dL| bound exceeds the step fraction or a crossing's time needs it (refine()).
+void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
+    step_t0_ = t0;
+    step_len_ = t1 - t0;
+    places_n_ = 0;
+    if (slot_tag_.empty()) {
+        slot_tag_.assign(256, 0);
+        slot_place_.resize(256);
+    }
+    for (const std::uint32_t i : slots_used_) slot_tag_[i] = 0;
+    slots_used_.clear();
+    // Each object's box over the step: its vertices at both ends, widened by 2 px (a vertex
+    // moves less than kMaxMove between them, along a path close to the straight one). An
+    // object can cover a pixel within the step only inside it.
+    step_box_.resize(scene_.objects.size());
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
+        Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
+        for (const auto* polys : {&prev_polys_[o], &polys_[o]})
+            for (const auto& piece : *polys)
+                for (const Vec2& q : piece)
+                    b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
+        step_box_[o] = {b.x0 - 2.0, b.x1 + 2.0, b.y0 - 2.0, b.y1 + 2.0};
+    }
+    double worst = 0;
     for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
         const std::size_t p = pix;
         const double a = cur_[p], b = next_[p];
         cur_[p] = b;
-        if (b > a) {
-            if (b < ion_[p]) continue;
-            do {
-                emit(p, t0 + (ion_[p] - a) / (b - a) * dt, 1);
-                lref_[p] += con_[p];
-                ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
-            } while (b >= ion_[p]);
-            ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;  // only the last reference's is needed
-        } else {
-            if (b > ioff_[p]) continue;
-            do {
-                emit(p, t0 + (ioff_[p] - a) / (b - a) * dt, 0);
-                lref_[p] -= coff_[p];
-                ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
-            } while (b <= ioff_[p]);
-            ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+        const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
+        // Most pixels neither exceed the limit nor cross: nothing to do but note the change.
+        if (d <= limit_ * den && (b > a ? b < ion_[p] : b > ioff_[p])) {
+            worst = std::max(worst, d / den);
+            continue;
         }
+        refine(p, 0, kKeyEnd, a, b, false, ev);
     }
+    stats_.max_step_change = std::max(stats_.max_step_change, worst / scene_.camera.contrast);
 }
 
 void Simulator::emit_noise(double t1, std::vector<Event>& ev) {
@@ -495,26 +655,20 @@ void Simulator::emit_noise(double t1, std::vector<Event>& ev) {
 bool Simulator::step(std::vector<Event>& out) {
     if (t_ >= end_) return false;
     const SimulationParams& sp = scene_.simulation;
-    const double limit = sp.step_fraction * scene_.camera.contrast;
     double dt = dt_;
     for (;;) {
         const double t1 = std::min(end_, t_ + dt);
         place_objects(t1);
         const double taken = t1 - t_;
         // Edges move less than a pixel per step, so that the pixels near them are all that
-        // can change (mark_edges).
+        // can change (mark_edges). The step fraction is kept per pixel (emit_crossings).
         const double moved = max_displacement();
         if (moved > kMaxMove && taken > sp.min_step_us) {
             ++stats_.rejected_steps;
             dt = std::max(sp.min_step_us, taken * 0.9 * kMaxMove / moved);
             continue;
         }
-        const double change = render(false);
-        if (change > limit && taken > sp.min_step_us) {
-            ++stats_.rejected_steps;
-            dt = std::max(sp.min_step_us, taken * std::max(0.1, 0.9 * limit / change));
-            continue;
-        }
+        render(false);
         step_events_.clear();
         emit_crossings(t_, t1, step_events_);
         emit_noise(t1, step_events_);
@@ -531,9 +685,7 @@ bool Simulator::step(std::vector<Event>& out) {
         std::swap(prev_y0_, cur_y0_);
         std::swap(prev_y1_, cur_y1_);
         ++stats_.steps;
-        stats_.max_step_change = std::max(stats_.max_step_change, change / scene_.camera.contrast);
-        dt_ = std::min(sp.max_step_us, change > 0 ? taken * std::clamp(0.9 * limit / change, 0.5, 2.0) : 2.0 * taken);
-        if (moved > 0) dt_ = std::min(dt_, taken * 0.9 * kMaxMove / moved * 2.0);
+        dt_ = std::min(kCoarseSteps * sp.max_step_us, moved > 0 ? taken * std::min(2.0, 0.9 * kMaxMove / moved) : 2.0 * taken);
         dt_ = std::max(dt_, sp.min_step_us);
         t_ = t1;
         return true;

@@ -42,12 +42,13 @@ inline constexpr double kLogEps = 0.001;
 
 struct SimStats {
     std::uint64_t steps = 0;
-    std::uint64_t rejected_steps = 0;  ///< retried shorter: some pixel's L changed too much
+    std::uint64_t rejected_steps = 0;  ///< retried shorter: some vertex moved too far
+    std::uint64_t pixel_samples = 0;   ///< single pixels sampled within steps (per-pixel refinement)
     std::uint64_t on = 0;
     std::uint64_t off = 0;
     std::uint64_t noise = 0;       ///< background-activity and hot-pixel events (counted in on/off too)
     std::uint64_t refractory = 0;  ///< crossings dropped by the refractory period
-    double max_step_change = 0;    ///< largest accepted per-step |delta L| / C (bounded via |dI| / (eps + min I))
+    double max_step_change = 0;    ///< largest |delta L| / C between two samples of a pixel (bounded via |dI| / (eps + min I))
 };
 
 class Simulator {
@@ -71,7 +72,7 @@ private:
         [[nodiscard]] bool empty() const noexcept { return x1 < x0 || y1 < y0; }
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
-    double render(bool all_rows);     // renders into next_ over the dirty pixels; returns max |dL| bound
+    void render(bool all_rows);       // renders into next_ over the dirty pixels; lists those that changed
     // An object's own accumulators: its edge walk's additions (coverage_walk.hpp) into a
     // window of rows y0 .. y1 and of words columns from x0 (a multiple of 64) that holds every
     // cell the walk can write at the time being rendered. cov gets the coverage additions, val
@@ -93,6 +94,25 @@ private:
     void walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
+    // Per-pixel sampling within a step (multirate): the times of a step [t0, t1] are keys,
+    // t0 + (t1 - t0) key / 2^kKeyBits, so that the pixels sampled at the same instant share
+    // one placement of the objects.
+    struct Box {
+        double x0, x1, y0, y1;
+    };
+    struct Placement {  // one object's pieces at one instant, with their bounding boxes
+        std::uint64_t tag = 0;  // object and key
+        std::vector<Vec2> v;  // the vertices, piece after piece (piece_first_, from the object's first)
+        std::vector<Box> piece;
+    };
+    [[nodiscard]] double key_time(std::uint64_t key) const noexcept;
+    const Placement& placement(std::size_t o, std::uint64_t key);
+    [[nodiscard]] double sample(std::size_t p, std::uint64_t key);  // pixel p's intensity at the key's time
+    // Pixel p from a (at key ka) to b (at kb): splits the interval until its |dL| bound is at
+    // most the step fraction and a crossing's interpolated time is settled, then emits.
+    void refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double a, double b, bool settled,
+                std::vector<Event>& ev);
+    void cross(std::size_t p, double ta, double tb, double a, double b, std::vector<Event>& ev);
     void emit_noise(double t1, std::vector<Event>& step_events);
     [[nodiscard]] std::uint64_t* row_bits(std::vector<std::uint64_t>& bits, int y) noexcept {
         return bits.data() + static_cast<std::size_t>(y) * words_;
@@ -124,6 +144,18 @@ private:
     std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
     std::vector<std::uint32_t> changed_;  // its first changed_n_: the dirty pixels whose next_ differs from cur_
     std::size_t changed_n_ = 0;
+    // Per-pixel sampling: the flat layout of every object's pieces' vertices (piece_first_,
+    // one entry per piece of every object in order, plus the end; object_first_piece_ likewise
+    // per object), each object's box over the whole step (step_box_), the placements of the
+    // current step (a pool reused from step to step) and their index by object and key; the
+    // step being refined and the crossing-time tolerance.
+    std::vector<std::size_t> piece_first_, object_first_piece_;
+    std::vector<Box> step_box_;
+    std::vector<Placement> places_;
+    std::size_t places_n_ = 0;
+    std::vector<std::uint64_t> slot_tag_;  // open addressing: tag + 1 of the placement (0: empty)
+    std::vector<std::uint32_t> slot_place_, slots_used_;
+    double step_t0_ = 0, step_len_ = 0, limit_ = 0, crossing_tol_us_ = 0;
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
     double noise_rate_per_us_ = 0;
