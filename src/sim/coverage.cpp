@@ -65,12 +65,13 @@ double pixel_coverage(std::span<const Vec2> poly, int x, int y) noexcept {
     double cov = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const Vec2 a = poly[i], b = poly[(i + 1) % n];
-        if (a.y == b.y) continue;  // horizontal edges bound no area to their right
+        // Outside the row band, horizontal (no area to its right) or right of the pixel: nothing.
+        if ((a.y <= py && b.y <= py) || (a.y >= py + 1.0 && b.y >= py + 1.0) || a.y == b.y) continue;
+        if (a.x >= px + 1.0 && b.x >= px + 1.0) continue;
         // As walk_coverage: an edge going up (in y) adds, one going down subtracts.
         const bool down = a.y < b.y;
         const Vec2 lo = down ? a : b, hi = down ? b : a;
         const double ya = std::max(lo.y, py), yb = std::min(hi.y, py + 1.0);
-        if (yb <= ya) continue;
         const double h = (down ? -1.0 : 1.0) * (yb - ya);
         const double dxdy = (hi.x - lo.x) / (hi.y - lo.y);
         const double xa = lo.x + (ya - lo.y) * dxdy, xb = lo.x + (yb - lo.y) * dxdy;

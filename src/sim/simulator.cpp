@@ -30,10 +30,6 @@ constexpr std::uint64_t kKeyEnd = std::uint64_t{1} << kKeyBits;
 // A crossing's interpolated time is settled when halving its interval moves it by at most
 // this times step_fraction, us.
 constexpr double kCrossingTolPerFraction = 10.0;
-// A step (a render of the whole image) is at most this many max_step_us long; a pixel's own
-// samples within it follow the step fraction, and a crossing is interpolated over at most
-// max_step_us.
-constexpr double kCoarseSteps = 1.0;
 
 
 // Horizontal edges are widened by this much (px) when marking the pixels they touch, so that
@@ -507,7 +503,8 @@ double Simulator::sample(std::size_t p, std::uint64_t key) {
     auto outside = [&](const Box& b) { return b.x1 <= x0 || b.x0 >= x1 || b.y1 <= y0 || b.y0 >= y1; };
     double v = bg_[p];
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
-        if (outside(step_box_[o])) continue;
+        const PixelRect& r = step_rect_[o];
+        if (x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1) continue;
         const Placement& pl = placement(o, key);
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
@@ -534,7 +531,7 @@ void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double
     const double q = std::abs(a - b) / (kLogEps + std::min(a, b));
     const bool splittable = tb - ta > scene_.simulation.min_step_us && kb - ka >= 2;
     const bool crosses = b > a ? b >= ion_[p] : b < a && b <= ioff_[p];
-    if (splittable && (q > limit_ || (crosses && tb - ta > scene_.simulation.max_step_us))) {
+    if (splittable && q > limit_) {
         // Halved: each part checked again.
         const std::uint64_t km = ka + (kb - ka) / 2;
         const double m = sample(p, km);
@@ -605,14 +602,19 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     // Each object's box over the step: its vertices at both ends, widened by 2 px (a vertex
     // moves less than kMaxMove between them, along a path close to the straight one). An
     // object can cover a pixel within the step only inside it.
-    step_box_.resize(scene_.objects.size());
+    step_rect_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
         Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
         for (const auto* polys : {&prev_polys_[o], &polys_[o]})
             for (const auto& piece : *polys)
                 for (const Vec2& q : piece)
                     b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
-        step_box_[o] = {b.x0 - 2.0, b.x1 + 2.0, b.y0 - 2.0, b.y1 + 2.0};
+        // As pixels (an empty rectangle when off the sensor; the clamp keeps the casts in range).
+        PixelRect& r = step_rect_[o];
+        r = {0, -1, 0, -1};
+        if (b.x1 + 2.0 >= 0 && b.y1 + 2.0 >= 0 && b.x0 - 2.0 < w_ && b.y0 - 2.0 < h_)
+            r = {static_cast<int>(std::floor(std::max(0.0, b.x0 - 2.0))), static_cast<int>(std::min(w_ - 1.0, b.x1 + 2.0)),
+                 static_cast<int>(std::floor(std::max(0.0, b.y0 - 2.0))), static_cast<int>(std::min(h_ - 1.0, b.y1 + 2.0))};
     }
     double worst = 0;
     for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
@@ -685,7 +687,7 @@ bool Simulator::step(std::vector<Event>& out) {
         std::swap(prev_y0_, cur_y0_);
         std::swap(prev_y1_, cur_y1_);
         ++stats_.steps;
-        dt_ = std::min(kCoarseSteps * sp.max_step_us, moved > 0 ? taken * std::min(2.0, 0.9 * kMaxMove / moved) : 2.0 * taken);
+        dt_ = std::min(sp.max_step_us, moved > 0 ? taken * std::min(2.0, 0.9 * kMaxMove / moved) : 2.0 * taken);
         dt_ = std::max(dt_, sp.min_step_us);
         t_ = t1;
         return true;

@@ -146,11 +146,14 @@ private:
     std::size_t changed_n_ = 0;
     // Per-pixel sampling: the flat layout of every object's pieces' vertices (piece_first_,
     // one entry per piece of every object in order, plus the end; object_first_piece_ likewise
-    // per object), each object's box over the whole step (step_box_), the placements of the
+    // per object), the pixels each object can cover within the step (step_rect_), the placements of the
     // current step (a pool reused from step to step) and their index by object and key; the
     // step being refined and the crossing-time tolerance.
     std::vector<std::size_t> piece_first_, object_first_piece_;
-    std::vector<Box> step_box_;
+    struct PixelRect {
+        int x0, x1, y0, y1;  // inclusive
+    };
+    std::vector<PixelRect> step_rect_;
     std::vector<Placement> places_;
     std::size_t places_n_ = 0;
     std::vector<std::uint64_t> slot_tag_;  // open addressing: tag + 1 of the placement (0: empty)
