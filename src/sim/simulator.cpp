@@ -126,6 +126,8 @@ Simulator::Simulator(Scene scene)
         ioff_[i] = std::exp(lref_[i] - coff_[i]) - kLogEps;
     }
     last_.assign(n, INT64_MIN / 2);
+    hist_.assign(n, 0.0);
+    hist_step_.assign(n, 0);
 
     piece_first_.assign(1, 0);
     object_first_piece_.assign(1, 0);
@@ -617,15 +619,39 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
                  static_cast<int>(std::floor(std::max(0.0, b.y0 - 2.0))), static_cast<int>(std::min(h_ - 1.0, b.y1 + 2.0))};
     }
     double worst = 0;
+    const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
     for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
         const std::size_t p = pix;
         const double a = cur_[p], b = next_[p];
         cur_[p] = b;
         const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
-        // Most pixels neither exceed the limit nor cross: nothing to do but note the change.
-        if (d <= limit_ * den && (b > a ? b < ion_[p] : b > ioff_[p])) {
-            worst = std::max(worst, d / den);
+        const bool had_history = hist_step_[p] == step_index;
+        const double h = hist_[p];
+        hist_[p] = a;
+        hist_step_[p] = step_index + 1;
+        if (d > limit_ * den) {
+            refine(p, 0, kKeyEnd, a, b, false, ev);
             continue;
+        }
+        worst = std::max(worst, d / den);
+        // Most pixels do not cross: nothing to do but note the change.
+        if (b > a ? b < ion_[p] : b > ioff_[p]) continue;
+        // A crossing. Where the pixel also changed in the step before, the parabola through
+        // its three values tells how far the crossing's time would move if I bends like it;
+        // within the tolerance the straight line is kept without a sample. A pixel that
+        // starts to change in this step (an edge enters it: a kink) is always sampled.
+        if (had_history) {
+            const double level = b > a ? ion_[p] : ioff_[p];
+            const double u = (level - a) / (b - a);  // the crossing's place in the step, 0 .. 1
+            const double r = last_len_ / step_len_;  // the step before, in units of this one
+            // Newton form through (-r, h), (0, a), (1, b): the parabola's departure from the
+            // line through (0, a) and (1, b) at u is c u (u - 1).
+            const double c = ((b - a) - (a - h) / r) / (1.0 + r);
+            const double shift = std::abs(c * u * (u - 1.0) / (b - a)) * step_len_;
+            if (shift <= crossing_tol_us_) {
+                cross(p, t0, t1, a, b, ev);
+                continue;
+            }
         }
         refine(p, 0, kKeyEnd, a, b, false, ev);
     }
@@ -687,6 +713,7 @@ bool Simulator::step(std::vector<Event>& out) {
         std::swap(prev_y0_, cur_y0_);
         std::swap(prev_y1_, cur_y1_);
         ++stats_.steps;
+        last_len_ = taken;
         dt_ = std::min(sp.max_step_us, moved > 0 ? taken * std::min(2.0, 0.9 * kMaxMove / moved) : 2.0 * taken);
         dt_ = std::max(dt_, sp.min_step_us);
         t_ = t1;

@@ -154,6 +154,13 @@ private:
         int x0, x1, y0, y1;  // inclusive
     };
     std::vector<PixelRect> step_rect_;
+    // Each pixel's value one step before cur_ (hist_), kept when it changed in that step too
+    // (hist_step_: that step's index + 1), and the length of the step before this one: with
+    // them a crossing's interval needs no midpoint sample where the three values say I is
+    // close enough to linear (emit_crossings).
+    std::vector<double> hist_;
+    std::vector<std::uint32_t> hist_step_;
+    double last_len_ = 0;
     std::vector<Placement> places_;
     std::size_t places_n_ = 0;
     std::vector<std::uint64_t> slot_tag_;  // open addressing: tag + 1 of the placement (0: empty)
