@@ -129,10 +129,8 @@ Simulator::Simulator(Scene scene)
     hist_.assign(n, 0.0);
     hist_step_.assign(n, 0);
 
-    piece_first_.assign(1, 0);
     object_first_piece_.assign(1, 0);
     for (const Object& obj : scene_.objects) {
-        for (const Piece& piece : obj.pieces) piece_first_.push_back(piece_first_.back() + piece.polygon.size());
         object_first_piece_.push_back(object_first_piece_.back() + obj.pieces.size());
     }
     limit_ = scene_.simulation.step_fraction * cam.contrast;
@@ -450,7 +448,7 @@ double Simulator::key_time(std::uint64_t key) const noexcept {
     return key == kKeyEnd ? step_t0_ + step_len_ : step_t0_ + step_len_ * (static_cast<double>(key) * (1.0 / static_cast<double>(kKeyEnd)));
 }
 
-const Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
+Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
     const std::uint64_t tag = key | (static_cast<std::uint64_t>(o) << (kKeyBits + 2));
     auto slot_of = [this](std::uint64_t t) {
         const std::size_t mask = slot_tag_.size() - 1;
@@ -478,45 +476,34 @@ const Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t ke
     if (places_.size() <= places_n_) places_.resize(places_n_ + 1);
     Placement& pl = places_[places_n_++];
     pl.tag = tag;
-    const Object& obj = scene_.objects[o];
-    const std::size_t k0 = object_first_piece_[o], first = piece_first_[k0];
-    pl.v.resize(piece_first_[object_first_piece_[o + 1]] - first);
-    pl.piece.resize(obj.pieces.size());
-    const Pose pose(obj.motion, key_time(key) / 1e6, scene_.duration_s);
-    Vec2* dst = pl.v.data();
-    for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-        Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
-        for (const Vec2& p0 : obj.pieces[k].polygon) {
-            const Vec2 q = pose.apply(p0);
-            *dst++ = q;
-            b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
-        }
-        pl.piece[k] = b;
-    }
+    pl.pose = Pose(scene_.objects[o].motion, key_time(key) / 1e6, scene_.duration_s);
+    pl.piece_at.assign(scene_.objects[o].pieces.size(), kNotPlaced);
     return pl;
 }
 
-// The same compositing as render(), for one pixel, with each piece's coverage from its edges.
+// The same compositing as render(), for one pixel, with each piece's coverage from its edges
+// (only the pieces that can reach the pixel within the step are placed).
 double Simulator::sample(std::size_t p, std::uint64_t key) {
     ++stats_.pixel_samples;
     const std::size_t w = static_cast<std::size_t>(w_);
     const int x = static_cast<int>(p % w), y = static_cast<int>(p / w);
-    const double x0 = x, x1 = x + 1.0, y0 = y, y1 = y + 1.0;
-    auto outside = [&](const Box& b) { return b.x1 <= x0 || b.x0 >= x1 || b.y1 <= y0 || b.y0 >= y1; };
+    auto outside = [&](const PixelRect& r) { return x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1; };
     double v = bg_[p];
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
-        const PixelRect& r = step_rect_[o];
-        if (x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1) continue;
-        const Placement& pl = placement(o, key);
+        if (outside(step_rect_[o])) continue;
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
-        const std::size_t first = piece_first_[object_first_piece_[o]];
+        Placement* pl = nullptr;
         double b = 0, s = 0;
         for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-            if (outside(pl.piece[k])) continue;
-            const std::size_t g = object_first_piece_[o] + k;
-            const double c = pixel_coverage(
-                std::span<const Vec2>(pl.v.data() + (piece_first_[g] - first), piece_first_[g + 1] - piece_first_[g]), x, y);
+            if (outside(piece_rect_[object_first_piece_[o] + k])) continue;
+            if (pl == nullptr) pl = &placement(o, key);
+            const std::vector<Vec2>& src = obj.pieces[k].polygon;
+            if (pl->piece_at[k] == kNotPlaced) {
+                pl->piece_at[k] = static_cast<std::uint32_t>(placed_.size());
+                for (const Vec2& q : src) placed_.push_back(pl->pose.apply(q));
+            }
+            const double c = pixel_coverage(std::span<const Vec2>(placed_.data() + pl->piece_at[k], src.size()), x, y);
             b += c;
             if (multi) s += c * obj.pieces[k].intensity;
         }
@@ -595,28 +582,37 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     step_t0_ = t0;
     step_len_ = t1 - t0;
     places_n_ = 0;
+    placed_.clear();
     if (slot_tag_.empty()) {
         slot_tag_.assign(256, 0);
         slot_place_.resize(256);
     }
     for (const std::uint32_t i : slots_used_) slot_tag_[i] = 0;
     slots_used_.clear();
-    // Each object's box over the step: its vertices at both ends, widened by 2 px (a vertex
-    // moves less than kMaxMove between them, along a path close to the straight one). An
-    // object can cover a pixel within the step only inside it.
+    // The pixels each piece (and each object) can cover within the step: its vertices at both
+    // ends, widened by 2 px (a vertex moves less than kMaxMove between them, along a path close
+    // to the straight one); an empty rectangle off the sensor.
     step_rect_.resize(scene_.objects.size());
+    piece_rect_.resize(object_first_piece_.back());
+    auto to_pixels = [&](double x0, double x1, double y0, double y1) {
+        PixelRect r{0, -1, 0, -1};
+        x0 -= 2.0, x1 += 2.0, y0 -= 2.0, y1 += 2.0;
+        if (x1 >= 0 && y1 >= 0 && x0 < w_ && y0 < h_)  // the clamps keep the casts in range
+            r = {static_cast<int>(std::floor(std::max(0.0, x0))), static_cast<int>(std::min(w_ - 1.0, x1)),
+                 static_cast<int>(std::floor(std::max(0.0, y0))), static_cast<int>(std::min(h_ - 1.0, y1))};
+        return r;
+    };
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
-        Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
-        for (const auto* polys : {&prev_polys_[o], &polys_[o]})
-            for (const auto& piece : *polys)
-                for (const Vec2& q : piece)
+        Box ob{INFINITY, -INFINITY, INFINITY, -INFINITY};
+        for (std::size_t k = 0; k < polys_[o].size(); ++k) {
+            Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
+            for (const auto* polys : {&prev_polys_[o][k], &polys_[o][k]})
+                for (const Vec2& q : *polys)
                     b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
-        // As pixels (an empty rectangle when off the sensor; the clamp keeps the casts in range).
-        PixelRect& r = step_rect_[o];
-        r = {0, -1, 0, -1};
-        if (b.x1 + 2.0 >= 0 && b.y1 + 2.0 >= 0 && b.x0 - 2.0 < w_ && b.y0 - 2.0 < h_)
-            r = {static_cast<int>(std::floor(std::max(0.0, b.x0 - 2.0))), static_cast<int>(std::min(w_ - 1.0, b.x1 + 2.0)),
-                 static_cast<int>(std::floor(std::max(0.0, b.y0 - 2.0))), static_cast<int>(std::min(h_ - 1.0, b.y1 + 2.0))};
+            piece_rect_[object_first_piece_[o] + k] = to_pixels(b.x0, b.x1, b.y0, b.y1);
+            ob = {std::min(ob.x0, b.x0), std::max(ob.x1, b.x1), std::min(ob.y0, b.y0), std::max(ob.y1, b.y1)};
+        }
+        step_rect_[o] = to_pixels(ob.x0, ob.x1, ob.y0, ob.y1);
     }
     double worst = 0;
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "evcorner/event.hpp"
+#include "evcorner/sim/motion.hpp"
 #include "evcorner/sim/random.hpp"
 #include "evcorner/sim/scene.hpp"
 
@@ -100,13 +101,14 @@ private:
     struct Box {
         double x0, x1, y0, y1;
     };
-    struct Placement {  // one object's pieces at one instant, with their bounding boxes
+    struct Placement {  // one object's pose at one instant, and its pieces placed so far
         std::uint64_t tag = 0;  // object and key
-        std::vector<Vec2> v;  // the vertices, piece after piece (piece_first_, from the object's first)
-        std::vector<Box> piece;
+        Pose pose;
+        std::vector<std::uint32_t> piece_at;  // per piece: its vertices' first index in placed_, or kNotPlaced
     };
+    static constexpr std::uint32_t kNotPlaced = UINT32_MAX;
     [[nodiscard]] double key_time(std::uint64_t key) const noexcept;
-    const Placement& placement(std::size_t o, std::uint64_t key);
+    Placement& placement(std::size_t o, std::uint64_t key);
     [[nodiscard]] double sample(std::size_t p, std::uint64_t key);  // pixel p's intensity at the key's time
     // Pixel p from a (at key ka) to b (at kb): splits the interval until its |dL| bound is at
     // most the step fraction and a crossing's interpolated time is settled, then emits.
@@ -144,16 +146,16 @@ private:
     std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
     std::vector<std::uint32_t> changed_;  // its first changed_n_: the dirty pixels whose next_ differs from cur_
     std::size_t changed_n_ = 0;
-    // Per-pixel sampling: the flat layout of every object's pieces' vertices (piece_first_,
-    // one entry per piece of every object in order, plus the end; object_first_piece_ likewise
-    // per object), the pixels each object can cover within the step (step_rect_), the placements of the
+    // Per-pixel sampling: each object's first piece in a numbering of every object's pieces in
+    // order (object_first_piece_, plus the end), the pixels each object can cover within the step (step_rect_), the placements of the
     // current step (a pool reused from step to step) and their index by object and key; the
     // step being refined and the crossing-time tolerance.
-    std::vector<std::size_t> piece_first_, object_first_piece_;
+    std::vector<std::size_t> object_first_piece_;
     struct PixelRect {
         int x0, x1, y0, y1;  // inclusive
     };
-    std::vector<PixelRect> step_rect_;
+    std::vector<PixelRect> step_rect_, piece_rect_;  // per object, per piece (global index)
+    std::vector<Vec2> placed_;  // the pieces placed at the step's sampled instants
     // Each pixel's value one step before cur_ (hist_), kept when it changed in that step too
     // (hist_step_: that step's index + 1), and the length of the step before this one: with
     // them a crossing's interval needs no midpoint sample where the three values say I is
