@@ -102,6 +102,50 @@ TEST(SimulateAnalytic, SquareEventTimesMatchTheCoverageCrossings) {
     std::printf("[ largest |timestamp - analytic crossing| over 19200 events: %.4f us ]\n", worst);
 }
 
+// The square moving 20 times faster (2000 px/s, its width in 20 ms): a step now moves the
+// edges up to 0.675 px, so a pixel's L changes by several C within one step and each edge
+// pixel is sampled on its own within the steps (per-pixel refinement). The counts stay exact
+// and the times within the crossing tolerance (50 us x step_fraction 0.5) plus rounding.
+const char* kFastSquare = R"({
+  "sensor": [240, 180], "duration_s": 0.02, "seed": 7,
+  "camera": {"contrast": 0.25, "contrast_sigma": 0, "refractory_us": 0, "noise_hz": 0},
+  "background": 0.5,
+  "objects": [{"polygon": [[60, 70], [100, 70], [100, 110], [60, 110]], "intensity": 0.1,
+               "motion": {"velocity": [2000, 0]}}]
+})";
+
+TEST(SimulateAnalytic, FastSquareIsRefinedPerPixelAndKeepsExactCountsAndTimes) {
+    Simulator sim(parse_scene(kFastSquare, "fast square"));
+    std::vector<Event> ev;
+    while (sim.step(ev)) {
+    }
+    EXPECT_GT(sim.stats().pixel_samples, 10000u);  // the refinement did the work
+    EXPECT_LE(sim.stats().max_step_change, 0.5 + 1e-9);
+    ASSERT_EQ(ev.size(), 19200u);
+    EXPECT_TRUE(time_ordered(ev));
+    std::map<std::pair<int, int>, int> seen;
+    double worst = 0;
+    for (const Event& e : ev) {
+        const int k = ++seen[{e.x, e.y}];
+        double t_s;
+        if (e.p == 0) {
+            EXPECT_TRUE(e.x >= 100 && e.x < 140 && e.y >= 70 && e.y < 110) << e.x << "," << e.y;
+            const double level = std::exp(std::log(0.501) - 0.25 * k) - 0.001;
+            t_s = (e.x + (0.5 - level) / 0.4 - 100.0) / 2000.0;
+        } else {
+            EXPECT_TRUE(e.x >= 60 && e.x < 100 && e.y >= 70 && e.y < 110) << e.x << "," << e.y;
+            const double level = std::exp(std::log(0.101) + 0.25 * k) - 0.001;
+            t_s = (e.x + (level - 0.1) / 0.4 - 60.0) / 2000.0;
+        }
+        worst = std::max(worst, std::abs(static_cast<double>(e.t) - t_s * 1e6));
+    }
+    EXPECT_EQ(seen.size(), 3200u);
+    for (const auto& [px, n] : seen) EXPECT_EQ(n, 6) << px.first << "," << px.second;
+    EXPECT_LE(worst, 0.5 + 25.0);
+    std::printf("[ fast square: %llu single-pixel samples; largest |timestamp - analytic crossing| over 19200 events: %.4f us ]\n",
+                static_cast<unsigned long long>(sim.stats().pixel_samples), worst);
+}
+
 // Exact coverage of one pixel by the polygon at time t, by the clipping oracle.
 double pixel_coverage_at(const Scene& s, double t_s, int x, int y) {
     const Object& o = s.objects[0];
@@ -319,6 +363,34 @@ TEST(SimulateStreaming, ImageEqualsAFullRenderAtEveryStepOfTheEdgeCases) {
     EXPECT_GT(events.size(), 1000u);
 }
 
+// Every single-pixel sample the refinement takes (at its own time within a step) against a
+// full render at that time, on the busy scene and the edge cases.
+TEST(SimulateStreaming, EverySinglePixelSampleEqualsAFullRender) {
+    for (const std::string& text : {busy(4), std::string(kEdgeCases)}) {
+        const Scene s = parse_scene(text, "scene");
+        Simulator sim(s);
+        std::vector<Simulator::PixelSample> samples;
+        sim.record_samples(&samples);
+        std::vector<Event> sink;
+        std::map<double, std::vector<double>> renders;
+        double worst = 0;
+        std::size_t checked = 0;
+        while (sim.step(sink)) {
+            for (std::size_t i = 0; i < samples.size(); ++i) {
+                const Simulator::PixelSample& x = samples[i];
+                auto it = renders.find(x.t_us);
+                if (it == renders.end()) it = renders.emplace(x.t_us, full_render(s, x.t_us)).first;
+                worst = std::max(worst, std::abs(it->second[x.pixel] - x.value));
+                ++checked;
+            }
+            samples.clear();
+            renders.clear();
+        }
+        EXPECT_LT(worst, 1e-9);
+        EXPECT_GT(checked, 100u);
+    }
+}
+
 // Random simple polygons, convex or not: star-shaped around a centre.
 std::vector<Vec2> random_polygon(Random& rng, double cx, double cy, double radius) {
     const int n = 3 + static_cast<int>(rng.below(8));
@@ -350,6 +422,26 @@ TEST(SimulateCoverage, MatchesTheClippingOracleExactlyAndTheSupersampledOne) {
     }
     EXPECT_LT(worst_clip, 1e-9);
     EXPECT_LT(worst_ss, 0.03);  // 64 x 64 samples: about 1.5 px of edge / 64
+}
+
+// One pixel's coverage from the edges alone (what the simulator samples between steps)
+// against the clipping oracle, at pixels inside, across and around random polygons,
+// including pixels off a sensor (negative coordinates).
+TEST(SimulateCoverage, PixelCoverageMatchesTheClippingOracle) {
+    Random rng(43);
+    double worst = 0;
+    int partial = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        const std::vector<Vec2> poly = random_polygon(rng, 20 * rng.uniform() - 5, 20 * rng.uniform() - 5, 2 + 8 * rng.uniform());
+        for (int y = -16; y < 26; ++y)
+            for (int x = -16; x < 26; ++x) {
+                const double want = naive::clipped_pixel_coverage(poly, x, y);
+                worst = std::max(worst, std::abs(pixel_coverage(poly, x, y) - want));
+                partial += want > 1e-6 && want < 1 - 1e-6;
+            }
+    }
+    EXPECT_LT(worst, 1e-9);
+    EXPECT_GT(partial, 1000);
 }
 
 TEST(SimulateCoverage, SumsToTheAreaAndOrientationDoesNotMatterAfterLoading) {

@@ -5,7 +5,6 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -29,7 +28,10 @@ constexpr int kKeyBits = 48;
 constexpr std::uint64_t kKeyEnd = std::uint64_t{1} << kKeyBits;
 // A crossing's interpolated time is settled when halving its interval moves it by at most
 // this times step_fraction, us.
-constexpr double kCrossingTolPerFraction = 10.0;
+constexpr double kCrossingTolPerFraction = 50.0;
+// The next step is shortened when the samples that keep the step fraction exceed this share of
+// the pixels a render recomputes (a sample costs several times a rendered pixel).
+constexpr double kSplitShare = 0.2;
 
 
 // Horizontal edges are widened by this much (px) when marking the pixels they touch, so that
@@ -511,6 +513,7 @@ double Simulator::sample(std::size_t p, std::uint64_t key) {
         const double bc = b >= 1.0 - kSnap ? 1.0 : b;
         v = v * (1.0 - bc) + (multi ? s : bc * obj.pieces[0].intensity);
     }
+    if (record_ != nullptr) record_->push_back({p, key_time(key), v});
     return v;
 }
 
@@ -522,6 +525,7 @@ void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double
     const bool crosses = b > a ? b >= ion_[p] : b < a && b <= ioff_[p];
     if (splittable && q > limit_) {
         // Halved: each part checked again.
+        ++split_samples_;
         const std::uint64_t km = ka + (kb - ka) / 2;
         const double m = sample(p, km);
         refine(p, ka, km, a, m, false, ev);
@@ -583,6 +587,7 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     step_len_ = t1 - t0;
     places_n_ = 0;
     placed_.clear();
+    split_samples_ = 0;
     if (slot_tag_.empty()) {
         slot_tag_.assign(256, 0);
         slot_place_.resize(256);
@@ -710,7 +715,14 @@ bool Simulator::step(std::vector<Event>& out) {
         std::swap(prev_y1_, cur_y1_);
         ++stats_.steps;
         last_len_ = taken;
-        dt_ = std::min(sp.max_step_us, moved > 0 ? taken * std::min(2.0, 0.9 * kMaxMove / moved) : 2.0 * taken);
+        // The next step: at most max_step_us, edges moving at most 0.9 kMaxMove, and short
+        // enough that the samples keeping the step fraction stay a small share of the pixels
+        // rendered (a sample costs several times a rendered pixel; kSplitShare).
+        double grow = 2.0;
+        if (moved > 0) grow = std::min(grow, 0.9 * kMaxMove / moved);
+        const double share = static_cast<double>(split_samples_) / static_cast<double>(std::max<std::size_t>(changed_n_, 1));
+        if (share > kSplitShare) grow = std::min(grow, std::max(0.5, kSplitShare / share));
+        dt_ = std::min(sp.max_step_us, taken * grow);
         dt_ = std::max(dt_, sp.min_step_us);
         t_ = t1;
         return true;

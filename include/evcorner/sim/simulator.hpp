@@ -67,6 +67,17 @@ public:
     /// The image at time_us(), row-major.
     [[nodiscard]] std::span<const double> image() const noexcept { return cur_; }
 
+    /// A single pixel sampled within a step (per-pixel refinement): pixel index, time in us,
+    /// intensity.
+    struct PixelSample {
+        std::size_t pixel;
+        double t_us;
+        double value;
+    };
+    /// When set, every single-pixel sample is appended to `out` (for tests: each can be
+    /// checked against a full render at its time); nullptr stops it.
+    void record_samples(std::vector<PixelSample>* out) noexcept { record_ = out; }
+
 private:
     struct Rect {
         int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // inclusive; empty when x1 < x0
@@ -163,6 +174,8 @@ private:
     std::vector<double> hist_;
     std::vector<std::uint32_t> hist_step_;
     double last_len_ = 0;
+    std::uint64_t split_samples_ = 0;
+    std::vector<PixelSample>* record_ = nullptr;  // samples of this step spent keeping the step fraction
     std::vector<Placement> places_;
     std::size_t places_n_ = 0;
     std::vector<std::uint64_t> slot_tag_;  // open addressing: tag + 1 of the placement (0: empty)
