@@ -8,10 +8,15 @@
 //   L = log(eps + I), eps = 0.001; each pixel keeps a reference level, set to L at t = 0
 //   an ON (OFF) event each time L reaches reference + C_on (reference - C_off); the
 //               reference then moves by that C. C_on, C_off ~ N(C, sigma) per pixel, drawn once
-//   crossing time: I is linear between two simulated instants (exact for an edge parallel to
+//   crossing time: I is linear between two samples of a pixel (exact for an edge parallel to
 //               a pixel side moving at constant speed), so the time at which I reaches the
-//               threshold's intensity exp(reference +- C) - eps is interpolated linearly in I
-//   steps adapt so that no pixel's L changes by more than step_fraction * C between them
+//               threshold's intensity exp(reference +- C) - eps is interpolated linearly in I;
+//               the interval is halved until that time moves by at most 50 us * step_fraction
+//   multirate: the image is rendered at steps of at most max_step_us (vertices moving less
+//               than 0.75 px); within a step a pixel whose L changed by more than
+//               step_fraction * C is sampled on its own (exact coverage at the instant,
+//               halving the interval) until no pixel's L changes by more than that between
+//               two of its samples
 //   refractory: an event less than refractory_us after the pixel's last emitted one is
 //               dropped (its reference still moves, so the pixel stays in step with the light)
 //   noise: Poisson background activity at noise_hz per pixel, random polarity, plus hot pixels
