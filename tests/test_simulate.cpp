@@ -73,6 +73,21 @@ TEST(SimulateAnalytic, SquareGivesSixEventsPerSweptPixelAndNothingElse) {
     }
 }
 
+// The k-th crossing of pixel e.x in the analytic square whose edges move at `speed` px/s, s.
+// A pixel x swept by an edge has coverage linear in time, so each crossing time is a closed form.
+double square_crossing_s(const Event& e, int k, double speed) {
+    if (e.p == 0) {
+        // Leading edge at 100 + speed t covers c = edge - x of the pixel: I = 0.5 - 0.4 c.
+        const double level = std::exp(std::log(0.501) - 0.25 * k) - 0.001;
+        const double c = (0.5 - level) / 0.4;
+        return (e.x + c - 100.0) / speed;
+    }
+    // Trailing edge at 60 + speed t uncovers u = edge - x: I = 0.1 + 0.4 u.
+    const double level = std::exp(std::log(0.101) + 0.25 * k) - 0.001;
+    const double u = (level - 0.1) / 0.4;
+    return (e.x + u - 60.0) / speed;
+}
+
 TEST(SimulateAnalytic, SquareEventTimesMatchTheCoverageCrossings) {
     const std::vector<Event> ev = simulate(parse_scene(kSquare, "square"));
     ASSERT_EQ(ev.size(), 19200u);
@@ -82,19 +97,7 @@ TEST(SimulateAnalytic, SquareEventTimesMatchTheCoverageCrossings) {
     double worst = 0;
     for (const Event& e : ev) {
         const int k = ++seen[{e.x, e.y}];
-        double t_s;
-        if (e.p == 0) {
-            // Leading edge at 100 + 100 t covers c = edge - x of the pixel: I = 0.5 - 0.4 c.
-            const double level = std::exp(std::log(0.501) - 0.25 * k) - 0.001;
-            const double c = (0.5 - level) / 0.4;
-            t_s = (e.x + c - 100.0) / 100.0;
-        } else {
-            // Trailing edge at 60 + 100 t uncovers u = edge - x: I = 0.1 + 0.4 u.
-            const double level = std::exp(std::log(0.101) + 0.25 * k) - 0.001;
-            const double u = (level - 0.1) / 0.4;
-            t_s = (e.x + u - 60.0) / 100.0;
-        }
-        worst = std::max(worst, std::abs(static_cast<double>(e.t) - t_s * 1e6));
+        worst = std::max(worst, std::abs(static_cast<double>(e.t) - square_crossing_s(e, k, 100.0) * 1e6));
     }
     // Rounding to the microsecond gives up to 0.5 us; the rest comes from the step in which an
     // edge enters a pixel (I is constant, then linear: a kink inside the step).
@@ -106,16 +109,15 @@ TEST(SimulateAnalytic, SquareEventTimesMatchTheCoverageCrossings) {
 // edges up to 0.675 px, so a pixel's L changes by several C within one step and each edge
 // pixel is sampled on its own within the steps (per-pixel refinement). The counts stay exact
 // and the times within the crossing tolerance (50 us x step_fraction 0.5) plus rounding.
-const char* kFastSquare = R"({
-  "sensor": [240, 180], "duration_s": 0.02, "seed": 7,
-  "camera": {"contrast": 0.25, "contrast_sigma": 0, "refractory_us": 0, "noise_hz": 0},
-  "background": 0.5,
-  "objects": [{"polygon": [[60, 70], [100, 70], [100, 110], [60, 110]], "intensity": 0.1,
-               "motion": {"velocity": [2000, 0]}}]
-})";
+std::string fast_square() {
+    std::string s = kSquare;
+    s.replace(s.find("\"duration_s\": 0.4"), 17, "\"duration_s\": 0.02");
+    s.replace(s.find("\"velocity\": [100, 0]"), 20, "\"velocity\": [2000, 0]");
+    return s;
+}
 
 TEST(SimulateAnalytic, FastSquareIsRefinedPerPixelAndKeepsExactCountsAndTimes) {
-    Simulator sim(parse_scene(kFastSquare, "fast square"));
+    Simulator sim(parse_scene(fast_square(), "fast square"));
     std::vector<Event> ev;
     while (sim.step(ev)) {
     }
@@ -127,17 +129,9 @@ TEST(SimulateAnalytic, FastSquareIsRefinedPerPixelAndKeepsExactCountsAndTimes) {
     double worst = 0;
     for (const Event& e : ev) {
         const int k = ++seen[{e.x, e.y}];
-        double t_s;
-        if (e.p == 0) {
-            EXPECT_TRUE(e.x >= 100 && e.x < 140 && e.y >= 70 && e.y < 110) << e.x << "," << e.y;
-            const double level = std::exp(std::log(0.501) - 0.25 * k) - 0.001;
-            t_s = (e.x + (0.5 - level) / 0.4 - 100.0) / 2000.0;
-        } else {
-            EXPECT_TRUE(e.x >= 60 && e.x < 100 && e.y >= 70 && e.y < 110) << e.x << "," << e.y;
-            const double level = std::exp(std::log(0.101) + 0.25 * k) - 0.001;
-            t_s = (e.x + (level - 0.1) / 0.4 - 60.0) / 2000.0;
-        }
-        worst = std::max(worst, std::abs(static_cast<double>(e.t) - t_s * 1e6));
+        // OFF only where the leading edge sweeps (columns 100..139), ON where the trailing one does.
+        EXPECT_TRUE(e.x >= (e.p ? 60 : 100) && e.x < (e.p ? 100 : 140) && e.y >= 70 && e.y < 110) << e.x << "," << e.y;
+        worst = std::max(worst, std::abs(static_cast<double>(e.t) - square_crossing_s(e, k, 2000.0) * 1e6));
     }
     EXPECT_EQ(seen.size(), 3200u);
     for (const auto& [px, n] : seen) EXPECT_EQ(n, 6) << px.first << "," << px.second;
