@@ -73,6 +73,21 @@ TEST(SimulateAnalytic, SquareGivesSixEventsPerSweptPixelAndNothingElse) {
     }
 }
 
+// The k-th crossing of pixel e.x in the analytic square whose edges move at `speed` px/s, s.
+// A pixel x swept by an edge has coverage linear in time, so each crossing time is a closed form.
+double square_crossing_s(const Event& e, int k, double speed) {
+    if (e.p == 0) {
+        // Leading edge at 100 + speed t covers c = edge - x of the pixel: I = 0.5 - 0.4 c.
+        const double level = std::exp(std::log(0.501) - 0.25 * k) - 0.001;
+        const double c = (0.5 - level) / 0.4;
+        return (e.x + c - 100.0) / speed;
+    }
+    // Trailing edge at 60 + speed t uncovers u = edge - x: I = 0.1 + 0.4 u.
+    const double level = std::exp(std::log(0.101) + 0.25 * k) - 0.001;
+    const double u = (level - 0.1) / 0.4;
+    return (e.x + u - 60.0) / speed;
+}
+
 TEST(SimulateAnalytic, SquareEventTimesMatchTheCoverageCrossings) {
     const std::vector<Event> ev = simulate(parse_scene(kSquare, "square"));
     ASSERT_EQ(ev.size(), 19200u);
@@ -82,24 +97,47 @@ TEST(SimulateAnalytic, SquareEventTimesMatchTheCoverageCrossings) {
     double worst = 0;
     for (const Event& e : ev) {
         const int k = ++seen[{e.x, e.y}];
-        double t_s;
-        if (e.p == 0) {
-            // Leading edge at 100 + 100 t covers c = edge - x of the pixel: I = 0.5 - 0.4 c.
-            const double level = std::exp(std::log(0.501) - 0.25 * k) - 0.001;
-            const double c = (0.5 - level) / 0.4;
-            t_s = (e.x + c - 100.0) / 100.0;
-        } else {
-            // Trailing edge at 60 + 100 t uncovers u = edge - x: I = 0.1 + 0.4 u.
-            const double level = std::exp(std::log(0.101) + 0.25 * k) - 0.001;
-            const double u = (level - 0.1) / 0.4;
-            t_s = (e.x + u - 60.0) / 100.0;
-        }
-        worst = std::max(worst, std::abs(static_cast<double>(e.t) - t_s * 1e6));
+        worst = std::max(worst, std::abs(static_cast<double>(e.t) - square_crossing_s(e, k, 100.0) * 1e6));
     }
     // Rounding to the microsecond gives up to 0.5 us; the rest comes from the step in which an
     // edge enters a pixel (I is constant, then linear: a kink inside the step).
     EXPECT_LE(worst, 3.0);
     std::printf("[ largest |timestamp - analytic crossing| over 19200 events: %.4f us ]\n", worst);
+}
+
+// The square moving 20 times faster (2000 px/s, its width in 20 ms): a step now moves the
+// edges up to 0.675 px, so a pixel's L changes by several C within one step and each edge
+// pixel is sampled on its own within the steps (per-pixel refinement). The counts stay exact
+// and the times within the crossing tolerance (50 us x step_fraction 0.5) plus rounding.
+std::string fast_square() {
+    std::string s = kSquare;
+    s.replace(s.find("\"duration_s\": 0.4"), 17, "\"duration_s\": 0.02");
+    s.replace(s.find("\"velocity\": [100, 0]"), 20, "\"velocity\": [2000, 0]");
+    return s;
+}
+
+TEST(SimulateAnalytic, FastSquareIsRefinedPerPixelAndKeepsExactCountsAndTimes) {
+    Simulator sim(parse_scene(fast_square(), "fast square"));
+    std::vector<Event> ev;
+    while (sim.step(ev)) {
+    }
+    EXPECT_GT(sim.stats().pixel_samples, 10000u);  // the refinement did the work
+    EXPECT_LE(sim.stats().max_step_change, 0.5 + 1e-9);
+    ASSERT_EQ(ev.size(), 19200u);
+    EXPECT_TRUE(time_ordered(ev));
+    std::map<std::pair<int, int>, int> seen;
+    double worst = 0;
+    for (const Event& e : ev) {
+        const int k = ++seen[{e.x, e.y}];
+        // OFF only where the leading edge sweeps (columns 100..139), ON where the trailing one does.
+        EXPECT_TRUE(e.x >= (e.p ? 60 : 100) && e.x < (e.p ? 100 : 140) && e.y >= 70 && e.y < 110) << e.x << "," << e.y;
+        worst = std::max(worst, std::abs(static_cast<double>(e.t) - square_crossing_s(e, k, 2000.0) * 1e6));
+    }
+    EXPECT_EQ(seen.size(), 3200u);
+    for (const auto& [px, n] : seen) EXPECT_EQ(n, 6) << px.first << "," << px.second;
+    EXPECT_LE(worst, 0.5 + 25.0);
+    std::printf("[ fast square: %llu single-pixel samples; largest |timestamp - analytic crossing| over 19200 events: %.4f us ]\n",
+                static_cast<unsigned long long>(sim.stats().pixel_samples), worst);
 }
 
 // Exact coverage of one pixel by the polygon at time t, by the clipping oracle.
@@ -319,6 +357,34 @@ TEST(SimulateStreaming, ImageEqualsAFullRenderAtEveryStepOfTheEdgeCases) {
     EXPECT_GT(events.size(), 1000u);
 }
 
+// Every single-pixel sample the refinement takes (at its own time within a step) against a
+// full render at that time, on the busy scene and the edge cases.
+TEST(SimulateStreaming, EverySinglePixelSampleEqualsAFullRender) {
+    for (const std::string& text : {busy(4), std::string(kEdgeCases)}) {
+        const Scene s = parse_scene(text, "scene");
+        Simulator sim(s);
+        std::vector<Simulator::PixelSample> samples;
+        sim.record_samples(&samples);
+        std::vector<Event> sink;
+        std::map<double, std::vector<double>> renders;
+        double worst = 0;
+        std::size_t checked = 0;
+        while (sim.step(sink)) {
+            for (std::size_t i = 0; i < samples.size(); ++i) {
+                const Simulator::PixelSample& x = samples[i];
+                auto it = renders.find(x.t_us);
+                if (it == renders.end()) it = renders.emplace(x.t_us, full_render(s, x.t_us)).first;
+                worst = std::max(worst, std::abs(it->second[x.pixel] - x.value));
+                ++checked;
+            }
+            samples.clear();
+            renders.clear();
+        }
+        EXPECT_LT(worst, 1e-9);
+        EXPECT_GT(checked, 100u);
+    }
+}
+
 // Random simple polygons, convex or not: star-shaped around a centre.
 std::vector<Vec2> random_polygon(Random& rng, double cx, double cy, double radius) {
     const int n = 3 + static_cast<int>(rng.below(8));
@@ -350,6 +416,26 @@ TEST(SimulateCoverage, MatchesTheClippingOracleExactlyAndTheSupersampledOne) {
     }
     EXPECT_LT(worst_clip, 1e-9);
     EXPECT_LT(worst_ss, 0.03);  // 64 x 64 samples: about 1.5 px of edge / 64
+}
+
+// One pixel's coverage from the edges alone (what the simulator samples between steps)
+// against the clipping oracle, at pixels inside, across and around random polygons,
+// including pixels off a sensor (negative coordinates).
+TEST(SimulateCoverage, PixelCoverageMatchesTheClippingOracle) {
+    Random rng(43);
+    double worst = 0;
+    int partial = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        const std::vector<Vec2> poly = random_polygon(rng, 20 * rng.uniform() - 5, 20 * rng.uniform() - 5, 2 + 8 * rng.uniform());
+        for (int y = -16; y < 26; ++y)
+            for (int x = -16; x < 26; ++x) {
+                const double want = naive::clipped_pixel_coverage(poly, x, y);
+                worst = std::max(worst, std::abs(pixel_coverage(poly, x, y) - want));
+                partial += want > 1e-6 && want < 1 - 1e-6;
+            }
+    }
+    EXPECT_LT(worst, 1e-9);
+    EXPECT_GT(partial, 1000);
 }
 
 TEST(SimulateCoverage, SumsToTheAreaAndOrientationDoesNotMatterAfterLoading) {

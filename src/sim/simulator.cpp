@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "evcorner/sim/coverage.hpp"
 #include "evcorner/sim/coverage_walk.hpp"
 #include "evcorner/sim/motion.hpp"
 #include "evcorner/sim/texture.hpp"
@@ -22,6 +23,16 @@ constexpr double kSnap = 1e-12;
 // Largest move of any vertex in one step, px (mark_edges needs less than 1).
 constexpr double kMaxMove = 0.75;
 constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
+// A step's instants within it are keys of this many bits (Simulator::key_time).
+constexpr int kKeyBits = 48;
+constexpr std::uint64_t kKeyEnd = std::uint64_t{1} << kKeyBits;
+// A crossing's interpolated time is settled when halving its interval moves it by at most
+// this times step_fraction, us.
+constexpr double kCrossingTolPerFraction = 50.0;
+// The next step is shortened when the samples that keep the step fraction exceed this share of
+// the pixels a render recomputes (a sample costs several times a rendered pixel).
+constexpr double kSplitShare = 0.2;
+
 
 // Horizontal edges are widened by this much (px) when marking the pixels they touch, so that
 // rounding never leaves out a pixel one grazes (an extra pixel costs only time).
@@ -117,6 +128,15 @@ Simulator::Simulator(Scene scene)
         ioff_[i] = std::exp(lref_[i] - coff_[i]) - kLogEps;
     }
     last_.assign(n, INT64_MIN / 2);
+    hist_.assign(n, 0.0);
+    hist_step_.assign(n, 0);
+
+    object_first_piece_.assign(1, 0);
+    for (const Object& obj : scene_.objects) {
+        object_first_piece_.push_back(object_first_piece_.back() + obj.pieces.size());
+    }
+    limit_ = scene_.simulation.step_fraction * cam.contrast;
+    crossing_tol_us_ = kCrossingTolPerFraction * scene_.simulation.step_fraction;
 
     const double noise_rate = cam.noise_hz * static_cast<double>(n) + cam.hot_pixel_hz * cam.hot_pixels;
     noise_rate_per_us_ = noise_rate / 1e6;
@@ -277,7 +297,7 @@ void Simulator::walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y
     }
 }
 
-double Simulator::render(bool all_rows) {
+void Simulator::render(bool all_rows) {
     if (all_rows) {
         for (int y = 0; y < h_; ++y) set_range(row_bits(dirty_, y), 0, w_ - 1);
         dirty_y0_ = 0;
@@ -395,29 +415,22 @@ double Simulator::render(bool all_rows) {
             }
         }
     }
-    // The dirty pixels that changed, and max |dL| over them, bounded by |dI| / (eps + min I)
-    // (log is concave).
+    // The dirty pixels that changed.
     changed_.resize(cur_.size());  // room for every pixel (only the first nc are kept)
     std::uint32_t* ch = changed_.data();
     std::size_t nc = 0;
-    double worst = 0;
     for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
         const std::uint64_t* d = row_bits(dirty_, y);
         const std::size_t base = static_cast<std::size_t>(y) * w;
         for (std::size_t k = 0; k < words_; ++k)
             for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
                 const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                const double a = cur_[i], b = next_[i];
-                // Without branches: every dirty pixel's index is written, kept when it
-                // changed; an unchanged one has quotient 0.
+                // Without branches: every dirty pixel's index is written, kept when it changed.
                 ch[nc] = static_cast<std::uint32_t>(i);
-                nc += a != b ? 1 : 0;
-                const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
-                worst = std::max(worst, d / den);
+                nc += cur_[i] != next_[i] ? 1 : 0;
             }
     }
     changed_n_ = nc;
-    return all_rows ? 0 : worst;
 }
 
 double Simulator::max_displacement() const noexcept {
@@ -433,11 +446,115 @@ double Simulator::max_displacement() const noexcept {
     return worst;
 }
 
-void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
-    const double dt = t1 - t0;
+double Simulator::key_time(std::uint64_t key) const noexcept {
+    return key == kKeyEnd ? step_t0_ + step_len_ : step_t0_ + step_len_ * (static_cast<double>(key) * (1.0 / static_cast<double>(kKeyEnd)));
+}
+
+Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
+    const std::uint64_t tag = key | (static_cast<std::uint64_t>(o) << (kKeyBits + 2));
+    auto slot_of = [this](std::uint64_t t) {
+        const std::size_t mask = slot_tag_.size() - 1;
+        std::size_t i = static_cast<std::size_t>((t * 0x9E3779B97F4A7C15ull) >> 40) & mask;
+        while (slot_tag_[i] != 0 && slot_tag_[i] != t + 1) i = (i + 1) & mask;
+        return i;
+    };
+    std::size_t i = slot_of(tag);
+    if (slot_tag_[i] != 0) return places_[slot_place_[i]];
+    if (2 * (places_n_ + 1) > slot_tag_.size()) {  // keep the table at most half full
+        slot_tag_.assign(2 * slot_tag_.size(), 0);
+        slot_place_.resize(slot_tag_.size());
+        slots_used_.clear();
+        for (std::size_t j = 0; j < places_n_; ++j) {
+            const std::size_t s = slot_of(places_[j].tag);
+            slot_tag_[s] = places_[j].tag + 1;
+            slot_place_[s] = static_cast<std::uint32_t>(j);
+            slots_used_.push_back(static_cast<std::uint32_t>(s));
+        }
+        i = slot_of(tag);
+    }
+    slot_tag_[i] = tag + 1;
+    slot_place_[i] = static_cast<std::uint32_t>(places_n_);
+    slots_used_.push_back(static_cast<std::uint32_t>(i));
+    if (places_.size() <= places_n_) places_.resize(places_n_ + 1);
+    Placement& pl = places_[places_n_++];
+    pl.tag = tag;
+    pl.pose = Pose(scene_.objects[o].motion, key_time(key) / 1e6, scene_.duration_s);
+    pl.piece_at.assign(scene_.objects[o].pieces.size(), kNotPlaced);
+    return pl;
+}
+
+// The same compositing as render(), for one pixel, with each piece's coverage from its edges
+// (only the pieces that can reach the pixel within the step are placed).
+double Simulator::sample(std::size_t p, std::uint64_t key) {
+    ++stats_.pixel_samples;
+    const std::size_t w = static_cast<std::size_t>(w_);
+    const int x = static_cast<int>(p % w), y = static_cast<int>(p / w);
+    auto outside = [&](const PixelRect& r) { return x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1; };
+    double v = bg_[p];
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
+        if (outside(step_rect_[o])) continue;
+        const Object& obj = scene_.objects[o];
+        const bool multi = obj.pieces.size() > 1;
+        Placement* pl = nullptr;
+        double b = 0, s = 0;
+        for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
+            if (outside(piece_rect_[object_first_piece_[o] + k])) continue;
+            if (pl == nullptr) pl = &placement(o, key);
+            const std::vector<Vec2>& src = obj.pieces[k].polygon;
+            if (pl->piece_at[k] == kNotPlaced) {
+                pl->piece_at[k] = static_cast<std::uint32_t>(placed_.size());
+                for (const Vec2& q : src) placed_.push_back(pl->pose.apply(q));
+            }
+            const double c = pixel_coverage(std::span<const Vec2>(placed_.data() + pl->piece_at[k], src.size()), x, y);
+            b += c;
+            if (multi) s += c * obj.pieces[k].intensity;
+        }
+        if (b <= kSnap) continue;
+        const double bc = b >= 1.0 - kSnap ? 1.0 : b;
+        v = v * (1.0 - bc) + (multi ? s : bc * obj.pieces[0].intensity);
+    }
+    if (record_ != nullptr) record_->push_back({p, key_time(key), v});
+    return v;
+}
+
+void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double a, double b, bool settled,
+                       std::vector<Event>& ev) {
+    const double ta = key_time(ka), tb = key_time(kb);
+    const double q = std::abs(a - b) / (kLogEps + std::min(a, b));
+    const bool splittable = tb - ta > scene_.simulation.min_step_us && kb - ka >= 2;
+    const bool crosses = b > a ? b >= ion_[p] : b < a && b <= ioff_[p];
+    if (splittable && q > limit_) {
+        // Halved: each part checked again.
+        ++split_samples_;
+        const std::uint64_t km = ka + (kb - ka) / 2;
+        const double m = sample(p, km);
+        refine(p, ka, km, a, m, false, ev);
+        refine(p, km, kb, m, b, false, ev);
+        return;
+    }
+    if (crosses && !settled && splittable) {
+        // I is taken as linear in the interval; the midpoint tells how far the crossing's time
+        // moves when the interval is halved. Settled within the tolerance, the halves are kept.
+        const std::uint64_t km = ka + (kb - ka) / 2;
+        const double m = sample(p, km), tm = key_time(km);
+        const double level = b > a ? ion_[p] : ioff_[p];
+        const double whole = ta + (level - a) / (b - a) * (tb - ta);
+        const bool first_half = b > a ? m >= level : m <= level;
+        const double halved = first_half ? ta + (level - a) / (m - a) * (tm - ta) : tm + (level - m) / (b - m) * (tb - tm);
+        const bool ok = std::abs(whole - halved) <= crossing_tol_us_;
+        refine(p, ka, km, a, m, ok, ev);
+        refine(p, km, kb, m, b, ok, ev);
+        return;
+    }
+    stats_.max_step_change = std::max(stats_.max_step_change, q / scene_.camera.contrast);
+    if (crosses) cross(p, ta, tb, a, b, ev);
+}
+
+void Simulator::cross(std::size_t p, double ta, double tb, double a, double b, std::vector<Event>& ev) {
+    const double dt = tb - ta;
     const double refractory = scene_.camera.refractory_us;
     const std::size_t w = static_cast<std::size_t>(w_);
-    auto emit = [&](std::size_t p, double tc, std::uint8_t pol) {
+    auto emit = [&](double tc, std::uint8_t pol) {
         const std::int64_t ts = std::max<std::int64_t>(1, std::llround(tc));
         if (refractory > 0 && static_cast<double>(ts - last_[p]) < refractory) {
             ++stats_.refractory;
@@ -446,28 +563,100 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         last_[p] = ts;
         ev.push_back({ts, static_cast<std::uint16_t>(p % w), static_cast<std::uint16_t>(p / w), pol});
     };
+    if (b > a) {
+        do {
+            emit(ta + (ion_[p] - a) / (b - a) * dt, 1);
+            lref_[p] += con_[p];
+            ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+        } while (b >= ion_[p]);
+        ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;  // only the last reference's is needed
+    } else {
+        do {
+            emit(ta + (ioff_[p] - a) / (b - a) * dt, 0);
+            lref_[p] -= coff_[p];
+            ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
+        } while (b <= ioff_[p]);
+        ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+    }
+}
+
+// Each changed pixel from its value at t0 to its value at t1, sampled on its own within the
+// step where its |dL| bound exceeds the step fraction or a crossing's time needs it (refine()).
+void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
+    step_t0_ = t0;
+    step_len_ = t1 - t0;
+    places_n_ = 0;
+    placed_.clear();
+    split_samples_ = 0;
+    if (slot_tag_.empty()) {
+        slot_tag_.assign(256, 0);
+        slot_place_.resize(256);
+    }
+    for (const std::uint32_t i : slots_used_) slot_tag_[i] = 0;
+    slots_used_.clear();
+    // The pixels each piece (and each object) can cover within the step: its vertices at both
+    // ends, widened by 2 px (a vertex moves less than kMaxMove between them, along a path close
+    // to the straight one); an empty rectangle off the sensor.
+    step_rect_.resize(scene_.objects.size());
+    piece_rect_.resize(object_first_piece_.back());
+    auto to_pixels = [&](double x0, double x1, double y0, double y1) {
+        PixelRect r{0, -1, 0, -1};
+        x0 -= 2.0, x1 += 2.0, y0 -= 2.0, y1 += 2.0;
+        if (x1 >= 0 && y1 >= 0 && x0 < w_ && y0 < h_)  // the clamps keep the casts in range
+            r = {static_cast<int>(std::floor(std::max(0.0, x0))), static_cast<int>(std::min(w_ - 1.0, x1)),
+                 static_cast<int>(std::floor(std::max(0.0, y0))), static_cast<int>(std::min(h_ - 1.0, y1))};
+        return r;
+    };
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
+        Box ob{INFINITY, -INFINITY, INFINITY, -INFINITY};
+        for (std::size_t k = 0; k < polys_[o].size(); ++k) {
+            Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
+            for (const auto* polys : {&prev_polys_[o][k], &polys_[o][k]})
+                for (const Vec2& q : *polys)
+                    b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
+            piece_rect_[object_first_piece_[o] + k] = to_pixels(b.x0, b.x1, b.y0, b.y1);
+            ob = {std::min(ob.x0, b.x0), std::max(ob.x1, b.x1), std::min(ob.y0, b.y0), std::max(ob.y1, b.y1)};
+        }
+        step_rect_[o] = to_pixels(ob.x0, ob.x1, ob.y0, ob.y1);
+    }
+    double worst = 0;
+    const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
     for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
         const std::size_t p = pix;
         const double a = cur_[p], b = next_[p];
         cur_[p] = b;
-        if (b > a) {
-            if (b < ion_[p]) continue;
-            do {
-                emit(p, t0 + (ion_[p] - a) / (b - a) * dt, 1);
-                lref_[p] += con_[p];
-                ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
-            } while (b >= ion_[p]);
-            ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;  // only the last reference's is needed
-        } else {
-            if (b > ioff_[p]) continue;
-            do {
-                emit(p, t0 + (ioff_[p] - a) / (b - a) * dt, 0);
-                lref_[p] -= coff_[p];
-                ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
-            } while (b <= ioff_[p]);
-            ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+        const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
+        const bool had_history = hist_step_[p] == step_index;
+        const double h = hist_[p];
+        hist_[p] = a;
+        hist_step_[p] = step_index + 1;
+        if (d > limit_ * den) {
+            refine(p, 0, kKeyEnd, a, b, false, ev);
+            continue;
         }
+        worst = std::max(worst, d / den);
+        // Most pixels do not cross: nothing to do but note the change.
+        if (b > a ? b < ion_[p] : b > ioff_[p]) continue;
+        // A crossing. Where the pixel also changed in the step before, the parabola through
+        // its three values tells how far the crossing's time would move if I bends like it;
+        // within the tolerance the straight line is kept without a sample. A pixel that
+        // starts to change in this step (an edge enters it: a kink) is always sampled.
+        if (had_history) {
+            const double level = b > a ? ion_[p] : ioff_[p];
+            const double u = (level - a) / (b - a);  // the crossing's place in the step, 0 .. 1
+            const double r = last_len_ / step_len_;  // the step before, in units of this one
+            // Newton form through (-r, h), (0, a), (1, b): the parabola's departure from the
+            // line through (0, a) and (1, b) at u is c u (u - 1).
+            const double c = ((b - a) - (a - h) / r) / (1.0 + r);
+            const double shift = std::abs(c * u * (u - 1.0) / (b - a)) * step_len_;
+            if (shift <= crossing_tol_us_) {
+                cross(p, t0, t1, a, b, ev);
+                continue;
+            }
+        }
+        refine(p, 0, kKeyEnd, a, b, false, ev);
     }
+    stats_.max_step_change = std::max(stats_.max_step_change, worst / scene_.camera.contrast);
 }
 
 void Simulator::emit_noise(double t1, std::vector<Event>& ev) {
@@ -495,26 +684,20 @@ void Simulator::emit_noise(double t1, std::vector<Event>& ev) {
 bool Simulator::step(std::vector<Event>& out) {
     if (t_ >= end_) return false;
     const SimulationParams& sp = scene_.simulation;
-    const double limit = sp.step_fraction * scene_.camera.contrast;
     double dt = dt_;
     for (;;) {
         const double t1 = std::min(end_, t_ + dt);
         place_objects(t1);
         const double taken = t1 - t_;
         // Edges move less than a pixel per step, so that the pixels near them are all that
-        // can change (mark_edges).
+        // can change (mark_edges). The step fraction is kept per pixel (emit_crossings).
         const double moved = max_displacement();
         if (moved > kMaxMove && taken > sp.min_step_us) {
             ++stats_.rejected_steps;
             dt = std::max(sp.min_step_us, taken * 0.9 * kMaxMove / moved);
             continue;
         }
-        const double change = render(false);
-        if (change > limit && taken > sp.min_step_us) {
-            ++stats_.rejected_steps;
-            dt = std::max(sp.min_step_us, taken * std::max(0.1, 0.9 * limit / change));
-            continue;
-        }
+        render(false);
         step_events_.clear();
         emit_crossings(t_, t1, step_events_);
         emit_noise(t1, step_events_);
@@ -531,9 +714,15 @@ bool Simulator::step(std::vector<Event>& out) {
         std::swap(prev_y0_, cur_y0_);
         std::swap(prev_y1_, cur_y1_);
         ++stats_.steps;
-        stats_.max_step_change = std::max(stats_.max_step_change, change / scene_.camera.contrast);
-        dt_ = std::min(sp.max_step_us, change > 0 ? taken * std::clamp(0.9 * limit / change, 0.5, 2.0) : 2.0 * taken);
-        if (moved > 0) dt_ = std::min(dt_, taken * 0.9 * kMaxMove / moved * 2.0);
+        last_len_ = taken;
+        // The next step: at most max_step_us, edges moving at most 0.9 kMaxMove, and short
+        // enough that the samples keeping the step fraction stay a small share of the pixels
+        // rendered (a sample costs several times a rendered pixel; kSplitShare).
+        double grow = 2.0;
+        if (moved > 0) grow = std::min(grow, 0.9 * kMaxMove / moved);
+        const double share = static_cast<double>(split_samples_) / static_cast<double>(std::max<std::size_t>(changed_n_, 1));
+        if (share > kSplitShare) grow = std::min(grow, std::max(0.5, kSplitShare / share));
+        dt_ = std::min(sp.max_step_us, taken * grow);
         dt_ = std::max(dt_, sp.min_step_us);
         t_ = t1;
         return true;

@@ -32,6 +32,12 @@ void accumulate_polygon(std::span<const Vec2> poly, double weight, double* acc, 
 void accumulate_polygon2(std::span<const Vec2> poly, double weight, double* acc, double weight2, double* acc2,
                          std::size_t stride, int width, int height) noexcept;
 
+/// The coverage of the one pixel (x, y) (any integers, on the sensor or not): the same area as
+/// the running sums give, computed from the edges alone (each edge's part in the row band
+/// [y, y + 1] adds its height times the mean fraction of the pixel to its right). Work: one
+/// pass over the edges; the simulator uses it to sample single pixels between steps.
+double pixel_coverage(std::span<const Vec2> poly, int x, int y) noexcept;
+
 /// The coverage of every pixel (row-major, width x height), each in [0, 1].
 std::vector<double> polygon_coverage(std::span<const Vec2> poly, SensorSize size);
 

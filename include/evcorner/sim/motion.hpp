@@ -15,6 +15,7 @@ double speed_factor(const SpeedProfile& p, double t_s, double duration_s) noexce
 /// with a = s R, and its time derivative for velocities.
 class Pose {
 public:
+    Pose() = default;  ///< the identity
     Pose(const Motion& m, double t_s, double duration_s) noexcept;
     [[nodiscard]] Vec2 apply(Vec2 p0) const noexcept {
         const double dx = p0.x - c0_.x, dy = p0.y - c0_.y;

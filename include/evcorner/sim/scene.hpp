@@ -81,9 +81,9 @@ struct Object {
 
 /// Numerical settings of the simulation (rarely changed).
 struct SimulationParams {
-    double step_fraction = 0.5;   ///< no pixel's log intensity changes by more than this times C per step
-    double max_step_us = 1000.0;  ///< longest step
-    double min_step_us = 1.0;     ///< shortest step (the fraction may be exceeded only at this size)
+    double step_fraction = 0.5;   ///< no pixel's log intensity changes by more than this times C between two of its samples
+    double max_step_us = 1000.0;  ///< longest step (between two renders of the whole image)
+    double min_step_us = 1.0;     ///< shortest step or pixel sample interval (the fraction may be exceeded only at this size)
 };
 
 struct Scene {

@@ -8,10 +8,15 @@
 //   L = log(eps + I), eps = 0.001; each pixel keeps a reference level, set to L at t = 0
 //   an ON (OFF) event each time L reaches reference + C_on (reference - C_off); the
 //               reference then moves by that C. C_on, C_off ~ N(C, sigma) per pixel, drawn once
-//   crossing time: I is linear between two simulated instants (exact for an edge parallel to
+//   crossing time: I is linear between two samples of a pixel (exact for an edge parallel to
 //               a pixel side moving at constant speed), so the time at which I reaches the
-//               threshold's intensity exp(reference +- C) - eps is interpolated linearly in I
-//   steps adapt so that no pixel's L changes by more than step_fraction * C between them
+//               threshold's intensity exp(reference +- C) - eps is interpolated linearly in I;
+//               the interval is halved until that time moves by at most 50 us * step_fraction
+//   multirate: the image is rendered at steps of at most max_step_us (vertices moving less
+//               than 0.75 px); within a step a pixel whose L changed by more than
+//               step_fraction * C is sampled on its own (exact coverage at the instant,
+//               halving the interval) until no pixel's L changes by more than that between
+//               two of its samples
 //   refractory: an event less than refractory_us after the pixel's last emitted one is
 //               dropped (its reference still moves, so the pixel stays in step with the light)
 //   noise: Poisson background activity at noise_hz per pixel, random polarity, plus hot pixels
@@ -33,6 +38,7 @@
 #include <vector>
 
 #include "evcorner/event.hpp"
+#include "evcorner/sim/motion.hpp"
 #include "evcorner/sim/random.hpp"
 #include "evcorner/sim/scene.hpp"
 
@@ -42,12 +48,13 @@ inline constexpr double kLogEps = 0.001;
 
 struct SimStats {
     std::uint64_t steps = 0;
-    std::uint64_t rejected_steps = 0;  ///< retried shorter: some pixel's L changed too much
+    std::uint64_t rejected_steps = 0;  ///< retried shorter: some vertex moved too far
+    std::uint64_t pixel_samples = 0;   ///< single pixels sampled within steps (per-pixel refinement)
     std::uint64_t on = 0;
     std::uint64_t off = 0;
     std::uint64_t noise = 0;       ///< background-activity and hot-pixel events (counted in on/off too)
     std::uint64_t refractory = 0;  ///< crossings dropped by the refractory period
-    double max_step_change = 0;    ///< largest accepted per-step |delta L| / C (bounded via |dI| / (eps + min I))
+    double max_step_change = 0;    ///< largest |delta L| / C between two samples of a pixel (bounded via |dI| / (eps + min I))
 };
 
 class Simulator {
@@ -65,13 +72,24 @@ public:
     /// The image at time_us(), row-major.
     [[nodiscard]] std::span<const double> image() const noexcept { return cur_; }
 
+    /// A single pixel sampled within a step (per-pixel refinement): pixel index, time in us,
+    /// intensity.
+    struct PixelSample {
+        std::size_t pixel;
+        double t_us;
+        double value;
+    };
+    /// When set, every single-pixel sample is appended to `out` (for tests: each can be
+    /// checked against a full render at its time); nullptr stops it.
+    void record_samples(std::vector<PixelSample>* out) noexcept { record_ = out; }
+
 private:
     struct Rect {
         int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // inclusive; empty when x1 < x0
         [[nodiscard]] bool empty() const noexcept { return x1 < x0 || y1 < y0; }
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
-    double render(bool all_rows);     // renders into next_ over the dirty pixels; returns max |dL| bound
+    void render(bool all_rows);       // renders into next_ over the dirty pixels; lists those that changed
     // An object's own accumulators: its edge walk's additions (coverage_walk.hpp) into a
     // window of rows y0 .. y1 and of words columns from x0 (a multiple of 64) that holds every
     // cell the walk can write at the time being rendered. cov gets the coverage additions, val
@@ -93,6 +111,26 @@ private:
     void walk_object(std::size_t o, std::uint64_t* marks, int& y0, int& y1);
     [[nodiscard]] double max_displacement() const noexcept;
     void emit_crossings(double t0, double t1, std::vector<Event>& step_events);
+    // Per-pixel sampling within a step (multirate): the times of a step [t0, t1] are keys,
+    // t0 + (t1 - t0) key / 2^kKeyBits, so that the pixels sampled at the same instant share
+    // one placement of the objects.
+    struct Box {
+        double x0, x1, y0, y1;
+    };
+    struct Placement {  // one object's pose at one instant, and its pieces placed so far
+        std::uint64_t tag = 0;  // object and key
+        Pose pose;
+        std::vector<std::uint32_t> piece_at;  // per piece: its vertices' first index in placed_, or kNotPlaced
+    };
+    static constexpr std::uint32_t kNotPlaced = UINT32_MAX;
+    [[nodiscard]] double key_time(std::uint64_t key) const noexcept;
+    Placement& placement(std::size_t o, std::uint64_t key);
+    [[nodiscard]] double sample(std::size_t p, std::uint64_t key);  // pixel p's intensity at the key's time
+    // Pixel p from a (at key ka) to b (at kb): splits the interval until its |dL| bound is at
+    // most the step fraction and a crossing's interpolated time is settled, then emits.
+    void refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double a, double b, bool settled,
+                std::vector<Event>& ev);
+    void cross(std::size_t p, double ta, double tb, double a, double b, std::vector<Event>& ev);
     void emit_noise(double t1, std::vector<Event>& step_events);
     [[nodiscard]] std::uint64_t* row_bits(std::vector<std::uint64_t>& bits, int y) noexcept {
         return bits.data() + static_cast<std::size_t>(y) * words_;
@@ -124,6 +162,30 @@ private:
     std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
     std::vector<std::uint32_t> changed_;  // its first changed_n_: the dirty pixels whose next_ differs from cur_
     std::size_t changed_n_ = 0;
+    // Per-pixel sampling: each object's first piece in a numbering of every object's pieces in
+    // order (object_first_piece_, plus the end), the pixels each object can cover within the step (step_rect_), the placements of the
+    // current step (a pool reused from step to step) and their index by object and key; the
+    // step being refined and the crossing-time tolerance.
+    std::vector<std::size_t> object_first_piece_;
+    struct PixelRect {
+        int x0, x1, y0, y1;  // inclusive
+    };
+    std::vector<PixelRect> step_rect_, piece_rect_;  // per object, per piece (global index)
+    std::vector<Vec2> placed_;  // the pieces placed at the step's sampled instants
+    // Each pixel's value one step before cur_ (hist_), kept when it changed in that step too
+    // (hist_step_: that step's index + 1), and the length of the step before this one: with
+    // them a crossing's interval needs no midpoint sample where the three values say I is
+    // close enough to linear (emit_crossings).
+    std::vector<double> hist_;
+    std::vector<std::uint32_t> hist_step_;
+    double last_len_ = 0;
+    std::uint64_t split_samples_ = 0;
+    std::vector<PixelSample>* record_ = nullptr;  // samples of this step spent keeping the step fraction
+    std::vector<Placement> places_;
+    std::size_t places_n_ = 0;
+    std::vector<std::uint64_t> slot_tag_;  // open addressing: tag + 1 of the placement (0: empty)
+    std::vector<std::uint32_t> slot_place_, slots_used_;
+    double step_t0_ = 0, step_len_ = 0, limit_ = 0, crossing_tol_us_ = 0;
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
     double noise_rate_per_us_ = 0;
