@@ -107,8 +107,10 @@ void print_summary(const std::string& what, const sim::Scene& scene, const RunTo
     fmt::print(stderr, "  events       {} ({} ON, {} OFF; {} noise; {} dropped by the refractory period)\n", t.events,
                t.stats.on, t.stats.off, t.stats.noise, t.stats.refractory);
     fmt::print(stderr, "  rate         {:.3f} M events per simulated second\n", ev / scene.duration_s / 1e6);
-    fmt::print(stderr, "  steps        {} ({} retried shorter; largest |dL| per step {:.3f} C)\n", t.stats.steps,
-               t.stats.rejected_steps, t.stats.max_step_change);
+    fmt::print(stderr,
+               "  steps        {} ({} retried shorter: a vertex moved 0.75 px or more; {} single-pixel samples "
+               "within steps; largest |dL| between two samples of a pixel {:.3f} C)\n",
+               t.stats.steps, t.stats.rejected_steps, t.stats.pixel_samples, t.stats.max_step_change);
     if (t.truth_rows > 0) fmt::print(stderr, "  truth        {} rows\n", t.truth_rows);
     fmt::print(stderr, "  wall time    {:.3f} s ({:.2f} M simulated events/s)\n", t.wall_s,
                t.wall_s > 0 ? ev / t.wall_s / 1e6 : 0.0);
