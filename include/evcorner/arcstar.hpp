@@ -124,15 +124,63 @@ private:
                     ArcStarCircles(d.sae_.size().width)};
         }
 
+        // The batch loop: process() event by event, except that the radius-4 test of a
+        // candidate (a passing event whose radius-3 test passed) runs one passing event
+        // later, after that event's radius-3 test and before its SAE write. The branch on
+        // the candidate's radius-3 outcome then waits on nothing in flight (its outcome was
+        // known an arc test earlier), so a mispredicted one costs a refill, not the
+        // latency of the test. Exact: neither arc test reads its own event's centre, so
+        // the radius-4 test still reads the SAE as it stood right after the candidate's
+        // write (rejected events in between write only the filter's state).
         template <class Search, bool Published>
         std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
             std::size_t corners = 0;
+            const std::int64_t* cand_centre = nullptr;  // the pending candidate, if any
+            std::int64_t cand_st = 0;
+            std::size_t cand = 0;
+            bool pending = false;
             for (std::size_t i = 0; i < events.size(); ++i) {
-                const bool c = process<Search, Published>(events[i]);
-                is_corner[i] = static_cast<std::uint8_t>(c);
+                const Event& e = events[i];
+                is_corner[i] = 0;
+                const int p = e.p & 1;
+                const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
+                const std::int64_t st = Sae::stored(e.t);
+                if (!filter_update<Published>(p, at, st)) continue;
+                std::int64_t* const centre = plane[p] + at;
+                const bool r3 = inside(e) && circles.pass3<Search, kArc3Min, kArc3Max>(centre, st, minority_only);
+                if (pending) {
+                    const bool c = circles.pass4<Search, kArc4Min, kArc4Max>(cand_centre, cand_st, minority_only);
+                    is_corner[cand] = static_cast<std::uint8_t>(c);
+                    corners += c;
+                }
+                *centre = st;
+                pending = r3;
+                cand_centre = centre;
+                cand_st = st;
+                cand = i;
+            }
+            if (pending) {
+                const bool c = circles.pass4<Search, kArc4Min, kArc4Max>(cand_centre, cand_st, minority_only);
+                is_corner[cand] = static_cast<std::uint8_t>(c);
                 corners += c;
             }
             return corners;
+        }
+
+        // The filter for an event of polarity p and stored time st at pixel index `at`;
+        // records it as the pixel's latest in every case.
+        template <bool Published>
+        bool filter_update(int p, std::ptrdiff_t at, std::int64_t st) const noexcept {
+            ArcStarLatest& l = latest[at];
+            const bool pass = !(Published || filter) |
+                              arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, !Published && zero_init);
+            l.t[p] = st;
+            return pass;
+        }
+        // Whether e lies off the border (its circles on the sensor).
+        bool inside(const Event& e) const noexcept {
+            return !(e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
+                     e.y >= height - kCircleMargin);
         }
 
         // Published: the caller knows filter && !zero_init.
@@ -141,16 +189,10 @@ private:
             const int p = e.p & 1;
             const std::ptrdiff_t i = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
             const std::int64_t st = Sae::stored(e.t);
-            ArcStarLatest& l = latest[i];
-            const bool pass = !(Published || filter) |
-                              arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, !Published && zero_init);
-            l.t[p] = st;
-            if (!pass) return false;
+            if (!filter_update<Published>(p, i, st)) return false;
             std::int64_t* const centre = plane[p] + i;
             *centre = st;
-            if (e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
-                e.y >= height - kCircleMargin)
-                return false;
+            if (!inside(e)) return false;
             return circles.pass<Search, kArc3Min, kArc3Max, kArc4Min, kArc4Max>(centre, minority_only);
         }
 

@@ -473,21 +473,43 @@ public:
     /// `centre` holds the event's own stored time (the caller has just written it).
     template <class Search, int Lmin3, int Lmax3, int Lmin4, int Lmax4>
     [[nodiscard]] bool pass(const std::int64_t* centre, bool minority_only) const noexcept {
+        return pass3<Search, Lmin3, Lmax3>(centre, *centre, minority_only) &&
+               pass4<Search, Lmin4, Lmax4>(centre, *centre, minority_only);
+    }
+
+    /// The radius-3 test alone, for an event of stored time `st` at `centre`. Reads only
+    /// the circle, not the centre: the event's own write may come before or after it.
+    template <class Search, int Lmin, int Lmax>
+    [[nodiscard]] bool pass3(const std::int64_t* centre, std::int64_t st, bool minority_only) const noexcept {
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
         if constexpr (std::is_same_v<Search, Avx512Search>) {
-            static_assert(Lmin3 == 3 && Lmax3 == 6 && Lmin4 == 4 && Lmax4 == 8);
-            return ArcStarAvx512::circle16_passes(centre, width_, *centre, minority_only) &&
-                   ArcStarAvx512::circle20_passes(centre, width_, *centre, minority_only);
+            static_assert(Lmin == 3 && Lmax == 6);
+            return ArcStarAvx512::circle16_passes(centre, width_, st, minority_only);
         } else
 #endif
         {
             // Offsets from compile-time circle coordinates: rows centre + dy * width with
             // constant column offsets.
             const std::ptrdiff_t w = width_;
-            return arcstar_circle_passes<kCircle3.size(), Lmin3, Lmax3, Search>(
-                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only) &&
-                   arcstar_circle_passes<kCircle4.size(), Lmin4, Lmax4, Search>(
-                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+            (void)st;
+            return arcstar_circle_passes<kCircle3.size(), Lmin, Lmax, Search>(
+                centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only);
+        }
+    }
+    /// The radius-4 test alone, as pass3().
+    template <class Search, int Lmin, int Lmax>
+    [[nodiscard]] bool pass4(const std::int64_t* centre, std::int64_t st, bool minority_only) const noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        if constexpr (std::is_same_v<Search, Avx512Search>) {
+            static_assert(Lmin == 4 && Lmax == 8);
+            return ArcStarAvx512::circle20_passes(centre, width_, st, minority_only);
+        } else
+#endif
+        {
+            const std::ptrdiff_t w = width_;
+            (void)st;
+            return arcstar_circle_passes<kCircle4.size(), Lmin, Lmax, Search>(
+                centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
         }
     }
 
