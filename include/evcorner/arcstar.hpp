@@ -124,14 +124,17 @@ private:
                     ArcStarCircles(d.sae_.size().width)};
         }
 
-        // The batch loop: process() event by event, except that the radius-4 test of a
-        // candidate (a passing event whose radius-3 test passed) runs one passing event
-        // later, after that event's radius-3 test and before its SAE write. The branch on
-        // the candidate's radius-3 outcome then waits on nothing in flight (its outcome was
-        // known an arc test earlier), so a mispredicted one costs a refill, not the
-        // latency of the test. Exact: neither arc test reads its own event's centre, so
-        // the radius-4 test still reads the SAE as it stood right after the candidate's
-        // write (rejected events in between write only the filter's state).
+        // The batch loop: process() event by event, with two branches moved away from the
+        // work they wait on, so that a mispredicted one costs a pipeline refill rather
+        // than the latency of that work (docs/arcstar.md, "The batch loop"):
+        // - the filter runs one event ahead (event i+1's outcome is computed, and its
+        //   latest time recorded, before event i's arc tests; the filter reads only the
+        //   latest times, which nothing else writes);
+        // - the radius-4 test of a candidate (a passing event whose radius-3 test passed)
+        //   runs one passing event later, after that event's radius-3 test and before its
+        //   SAE write. Exact: neither arc test reads its own event's centre, so the
+        //   radius-4 test still reads the SAE as it stood right after the candidate's
+        //   write (rejected events in between write only the filter's state).
         template <class Search, bool Published>
         std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
             std::size_t corners = 0;
@@ -139,13 +142,17 @@ private:
             std::int64_t cand_st = 0;
             std::size_t cand = 0;
             bool pending = false;
-            for (std::size_t i = 0; i < events.size(); ++i) {
+            const std::size_t n = events.size();
+            bool pass_next = n != 0 && filter_event<Published>(events[0]);
+            for (std::size_t i = 0; i < n; ++i) {
                 const Event& e = events[i];
                 is_corner[i] = 0;
+                const bool pass = pass_next;
+                if (i + 1 < n) pass_next = filter_event<Published>(events[i + 1]);
+                if (!pass) continue;
                 const int p = e.p & 1;
                 const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
                 const std::int64_t st = Sae::stored(e.t);
-                if (!filter_update<Published>(p, at, st)) continue;
                 std::int64_t* const centre = plane[p] + at;
                 const bool r3 = inside(e) && circles.pass3<Search, kArc3Min, kArc3Max>(centre, st, minority_only);
                 if (pending) {
@@ -176,6 +183,10 @@ private:
                               arcstar_filter_passes(st, l.t[p], l.t[p ^ 1], window, !Published && zero_init);
             l.t[p] = st;
             return pass;
+        }
+        template <bool Published>
+        bool filter_event(const Event& e) const noexcept {
+            return filter_update<Published>(e.p & 1, static_cast<std::ptrdiff_t>(e.y) * width + e.x, Sae::stored(e.t));
         }
         // Whether e lies off the border (its circles on the sensor).
         bool inside(const Event& e) const noexcept {
