@@ -141,8 +141,9 @@ TEST(ArcStarGrid, Ties) {
 
 // ---- the batch loop: a corner's radius-4 test runs one passing event late
 
-// The batch loop (ArcStar::View::run) tests a candidate's radius-4 circle after the next
-// passing event's radius-3 test, and must do it before that event's write. Here the next
+// The AVX-512 batch loop (ArcStar::View::run_moved) tests a candidate's radius-4 circle
+// after the next passing event's radius-3 test, and must do it before that event's write
+// (the other loops test it at once; they are held to the same stream). Here the next
 // passing event after the corner E lands on E's radius-4 circle (dx = -4, dy = 0), same
 // polarity, 60 ms later (so that it passes the filter), newer than everything: seen by E's
 // radius-4 test, it would break E's arc (not a corner). A
