@@ -5,11 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "evcorner/arcstar.hpp"
+#include "evcorner/cpu_paths.hpp"
 #include "evcorner/naive/arcstar_naive.hpp"
 #include "grid_test_util.hpp"
 
@@ -134,6 +137,75 @@ TEST(ArcStarGrid, Ties) {
     EXPECT_TRUE(grid_is_corner(replace(kOutsideCorner, '9', '3')));
     // Never-fired pixels are the oldest of all: the corner over an unlit background.
     EXPECT_TRUE(grid_is_corner(replace(kOutsideCorner, '2', '.')));
+}
+
+// ---- the batch loop: a corner's radius-4 test runs one passing event late
+
+// The AVX-512 batch loop (ArcStar::View::run_moved) tests a candidate's radius-4 circle
+// after the next passing event's radius-3 test, and must do it before that event's write
+// (the other loops test it at once; they are held to the same stream). Here the next
+// passing event after the corner E lands on E's radius-4 circle (dx = -4, dy = 0), same
+// polarity, 60 ms later (so that it passes the filter), newer than everything: seen by E's
+// radius-4 test, it would break E's arc (not a corner). A
+// rejected event (E's pixel again, 1 us later) comes in between. Every loop, the whole
+// stream and the stream cut right after E (the candidate then waits for the next span),
+// must give the oracle's flags, E a corner.
+template <class Run>
+void expect_batch_equals_oracle(const char* path, Run run) {
+    const SensorSize size{20, 20};
+    int ex = -1, ey = -1;
+    std::vector<Event> events;
+    for (const test::Cell& c : parse_grid(kOutsideCorner, 5, 5, ex, ey))
+        events.push_back({c.t, static_cast<std::uint16_t>(c.x), static_cast<std::uint16_t>(c.y), 1});
+    const std::size_t corner = events.size();
+    const auto at = [](int x, int y, std::int64_t t) {
+        return Event{t, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), 1};
+    };
+    events.push_back(at(ex, ey, 1000));      // E: a corner
+    events.push_back(at(ex, ey, 1001));      // rejected by the filter (1 us after E)
+    events.push_back(at(ex - 4, ey, 60000));  // on E's radius-4 circle: passes, newest of all
+    events.push_back(at(ex + 1, ey, 60001));
+    naive::ArcStarNaive oracle(size);
+    std::vector<std::uint8_t> want;
+    for (const Event& e : events) want.push_back(oracle.process(e));
+    ASSERT_EQ(want[corner], 1);
+    ASSERT_EQ(want[corner + 1], 0);
+    for (const std::size_t cut : {events.size(), corner + 1}) {
+        ArcStar det(size);
+        std::vector<std::uint8_t> got(events.size(), 7);
+        const std::span<const Event> all(events);
+        const std::span<std::uint8_t> flags(got);
+        const std::size_t n = run(det, all.first(cut), flags.first(cut)) +
+                              run(det, all.subspan(cut), flags.subspan(cut));
+        EXPECT_EQ(got, want) << path << ", cut after " << cut;
+        EXPECT_EQ(n, static_cast<std::size_t>(std::count(want.begin(), want.end(), 1))) << path;
+    }
+}
+
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+[[gnu::target("avx2"), gnu::flatten]] std::size_t run_avx2(ArcStar& det, std::span<const Event> events,
+                                                           std::span<std::uint8_t> flags) {
+    return det.run_unchecked<Avx2Search>(events, flags);
+}
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t run_avx512(ArcStar& det,
+                                                                              std::span<const Event> events,
+                                                                              std::span<std::uint8_t> flags) {
+    return det.run_unchecked<Avx512Search>(events, flags);
+}
+#endif
+
+TEST(ArcStarBatch, RadiusFourTestSeesTheSaeOfItsOwnEvent) {
+    expect_batch_equals_oracle("portable", [](ArcStar& d, std::span<const Event> e, std::span<std::uint8_t> f) {
+        return d.run_unchecked<ScalarSearch>(e, f);
+    });
+    expect_batch_equals_oracle("detect()", [](ArcStar& d, std::span<const Event> e, std::span<std::uint8_t> f) {
+        return detect(d, e, f);
+    });
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    if (cpu_runs_avx2()) expect_batch_equals_oracle("avx2", run_avx2);
+    if (cpu_runs_avx512()) expect_batch_equals_oracle("avx512", run_avx512);
+    else GTEST_LOG_(INFO) << "no AVX-512 on this CPU: that loop not run";
+#endif
 }
 
 // ---- the filter

@@ -473,21 +473,35 @@ public:
     /// `centre` holds the event's own stored time (the caller has just written it).
     template <class Search, int Lmin3, int Lmax3, int Lmin4, int Lmax4>
     [[nodiscard]] bool pass(const std::int64_t* centre, bool minority_only) const noexcept {
+        return pass_circle<Search, kCircle3.size(), Lmin3, Lmax3>(centre, *centre, minority_only) &&
+               pass_circle<Search, kCircle4.size(), Lmin4, Lmax4>(centre, *centre, minority_only);
+    }
+
+    /// One circle's test alone (N = 16: radius 3, N = 20: radius 4), for an event of stored
+    /// time `st` at `centre`. Reads only the circle, not the centre: the event's own write
+    /// may come before or after it.
+    template <class Search, int N, int Lmin, int Lmax>
+    [[nodiscard]] bool pass_circle(const std::int64_t* centre, std::int64_t st, bool minority_only) const noexcept {
+        static_assert(N == 16 || N == 20);
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
         if constexpr (std::is_same_v<Search, Avx512Search>) {
-            static_assert(Lmin3 == 3 && Lmax3 == 6 && Lmin4 == 4 && Lmax4 == 8);
-            return ArcStarAvx512::circle16_passes(centre, width_, *centre, minority_only) &&
-                   ArcStarAvx512::circle20_passes(centre, width_, *centre, minority_only);
+            static_assert((N == 16 && Lmin == 3 && Lmax == 6) || (N == 20 && Lmin == 4 && Lmax == 8));
+            if constexpr (N == 16) return ArcStarAvx512::circle16_passes(centre, width_, st, minority_only);
+            else return ArcStarAvx512::circle20_passes(centre, width_, st, minority_only);
         } else
 #endif
         {
             // Offsets from compile-time circle coordinates: rows centre + dy * width with
             // constant column offsets.
             const std::ptrdiff_t w = width_;
-            return arcstar_circle_passes<kCircle3.size(), Lmin3, Lmax3, Search>(
-                       centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only) &&
-                   arcstar_circle_passes<kCircle4.size(), Lmin4, Lmax4, Search>(
-                       centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+            (void)st;
+            return arcstar_circle_passes<N, Lmin, Lmax, Search>(
+                centre,
+                [w](int k) {
+                    if constexpr (N == 16) return kCircle3[k].dy * w + kCircle3[k].dx;
+                    else return kCircle4[k].dy * w + kCircle4[k].dx;
+                },
+                minority_only);
         }
     }
 
