@@ -29,6 +29,7 @@
 #include "evcorner/efast.hpp"
 #include "evcorner/fa_harris.hpp"
 #include "real_files.hpp"
+#include "timing.hpp"
 
 namespace fs = std::filesystem;
 using namespace evcorner;
@@ -56,15 +57,10 @@ double now_ns() {
     static const bool wall = std::getenv("EVCORNER_BENCH_WALL") != nullptr;
     if (wall)
         return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now().time_since_epoch()).count();
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) * 1e9 + static_cast<double>(ts.tv_nsec);
+    return bench::thread_cpu_ns();
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using bench::median;
 
 // One timed run of detector d over f with a fresh detector; ns/event. Checks the goldens.
 double run(int d, File& f, std::vector<std::uint8_t>& flags, bool& golden_ok) {

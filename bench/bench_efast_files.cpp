@@ -17,6 +17,7 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/efast.hpp"
 #include "real_files.hpp"
+#include "timing.hpp"
 
 namespace fs = std::filesystem;
 using namespace evcorner;
@@ -37,10 +38,7 @@ File load(const bench::RealFile& r) {
     return f;
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using bench::median;
 
 }  // namespace
 

@@ -29,15 +29,13 @@
 #include "evcorner/efast.hpp"
 #include "evcorner/nms.hpp"
 #include "real_files.hpp"
+#include "timing.hpp"
 
 namespace fs = std::filesystem;
 using namespace evcorner;
 
 namespace {
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using bench::median;
 using Clock = std::chrono::steady_clock;
 }  // namespace
 
@@ -104,9 +102,7 @@ int main(int argc, char** argv) {
     // a shared machine does not count (page faults and other system time do).
     const auto now = [cpu_time] {
         if (!cpu_time) return std::chrono::duration<double, std::nano>(Clock::now().time_since_epoch()).count();
-        timespec ts{};
-        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-        return 1e9 * static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec);
+        return bench::thread_cpu_ns();
     };
     const auto real = bench::real_240x180_files(fs::path(EVCORNER_SHARED_DIR) / "data");
     if (real.empty()) {

@@ -47,22 +47,13 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/registry.hpp"
 #include "real_files.hpp"
+#include "timing.hpp"
 
 namespace {
 
 using namespace evcorner;
 
-double cpu_ns() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) * 1e9 + static_cast<double>(ts.tv_nsec);
-}
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using bench::median;
 
 struct Figures {
     double first = 0, rest = 0, learned = 0;
@@ -79,9 +70,9 @@ Figures round(const std::string& name, SensorSize sensor, std::span<const Event>
         std::visit(
             [&](auto& det) {
                 for (std::size_t i = 0; i + chunk <= events.size(); i += chunk) {
-                    const double t0 = cpu_ns();
+                    const double t0 = bench::thread_cpu_ns();
                     detect(det, events.subspan(i, chunk), flags);
-                    const double ns = (cpu_ns() - t0) / static_cast<double>(chunk);
+                    const double ns = (bench::thread_cpu_ns() - t0) / static_cast<double>(chunk);
                     if (i == 0)
                         f.first = ns;
                     else
@@ -100,9 +91,9 @@ Figures round(const std::string& name, SensorSize sensor, std::span<const Event>
         AnyDetector any = make_detector(name, sensor);
         std::visit(
             [&](auto& det) {
-                const double t0 = cpu_ns();
+                const double t0 = bench::thread_cpu_ns();
                 detect(det, std::span<const Event>(copy), flags);
-                if (r > 10) learned.push_back((cpu_ns() - t0) / static_cast<double>(chunk));
+                if (r > 10) learned.push_back((bench::thread_cpu_ns() - t0) / static_cast<double>(chunk));
             },
             any);
     }
@@ -135,9 +126,9 @@ double images_round(const std::string& name, SensorSize sensor, std::span<const 
                     copy[i] = image(head[i], v, sensor);
                     copy[i].t += static_cast<std::int64_t>(r) * shift;
                 }
-                const double t0 = cpu_ns();
+                const double t0 = bench::thread_cpu_ns();
                 detect(det, std::span<const Event>(copy), flags);
-                if (r >= 8) ns.push_back((cpu_ns() - t0) / static_cast<double>(head.size()));
+                if (r >= 8) ns.push_back((bench::thread_cpu_ns() - t0) / static_cast<double>(head.size()));
             }
         },
         any);
