@@ -107,26 +107,17 @@ Simulator::Simulator(Scene scene)
     cur_ = next_;
 
     const CameraParams& cam = scene_.camera;
+    // Each pixel's thresholds and reference level are set when it first changes
+    // (ready_pixel()): most pixels never do, and their logs, exponentials and normal draws
+    // would be most of the set-up. The draws are the same as drawing every pixel's in order:
+    // pixel i's are the 4 i-th to (4 i + 3)-th numbers of the thresholds' stream.
     lref_.resize(n);
     ion_.resize(n);
     ioff_.resize(n);
     con_.resize(n);
     coff_.resize(n);
-    Random thr(scene_.seed, kSaltThresholds);
-    // A threshold below 1 % of C would fire on rounding noise; the normal's far tail is cut there.
-    const double floor_c = 0.01 * cam.contrast;
-    for (std::size_t i = 0; i < n; ++i) {
-        double a = cam.contrast, b = cam.contrast;
-        if (cam.contrast_sigma > 0) {
-            a = std::max(floor_c, cam.contrast + cam.contrast_sigma * thr.normal());
-            b = std::max(floor_c, cam.contrast + cam.contrast_sigma * thr.normal());
-        }
-        con_[i] = static_cast<float>(a);
-        coff_[i] = static_cast<float>(b);
-        lref_[i] = std::log(kLogEps + cur_[i]);
-        ion_[i] = std::exp(lref_[i] + con_[i]) - kLogEps;
-        ioff_[i] = std::exp(lref_[i] - coff_[i]) - kLogEps;
-    }
+    ready_.assign(n, 0);
+    thresholds_rng_ = Random(scene_.seed, kSaltThresholds);
     last_.assign(n, INT64_MIN / 2);
     hist_.assign(n, 0.0);
     hist_step_.assign(n, 0);
@@ -148,6 +139,28 @@ Simulator::Simulator(Scene scene)
         hot_.assign(chosen.begin(), chosen.end());
     }
     next_noise_ = noise_rate_per_us_ > 0 ? noise_rng_.exponential(1.0 / noise_rate_per_us_) : end_ + 1.0;
+}
+
+// Pixel p's thresholds (drawn from the thresholds' stream at pixel p's place: two normals, each
+// two numbers) and its reference level, set from its value at t = 0, which is cur_[p] until it
+// first changes.
+void Simulator::ready_pixel(std::size_t p) {
+    ready_[p] = 1;
+    const CameraParams& cam = scene_.camera;
+    double a = cam.contrast, b = cam.contrast;
+    if (cam.contrast_sigma > 0) {
+        Random thr = thresholds_rng_;
+        thr.skip(4 * static_cast<std::uint64_t>(p));
+        // A threshold below 1 % of C would fire on rounding noise; the normal's far tail is cut there.
+        const double floor_c = 0.01 * cam.contrast;
+        a = std::max(floor_c, cam.contrast + cam.contrast_sigma * thr.normal());
+        b = std::max(floor_c, cam.contrast + cam.contrast_sigma * thr.normal());
+    }
+    con_[p] = static_cast<float>(a);
+    coff_[p] = static_cast<float>(b);
+    lref_[p] = std::log(kLogEps + cur_[p]);
+    ion_[p] = std::exp(lref_[p] + con_[p]) - kLogEps;
+    ioff_[p] = std::exp(lref_[p] - coff_[p]) - kLogEps;
 }
 
 void Simulator::place_objects(double t_us) {
@@ -623,6 +636,7 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
     for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
         const std::size_t p = pix;
+        if (ready_[p] == 0) ready_pixel(p);
         const double a = cur_[p], b = next_[p];
         cur_[p] = b;
         const double d = std::abs(a - b), den = kLogEps + std::min(a, b);

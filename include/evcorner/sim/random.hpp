@@ -21,6 +21,8 @@ public:
         z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
         return z ^ (z >> 31);
     }
+    /// Skips the next n numbers (SplitMix64's state moves by a constant per number).
+    void skip(std::uint64_t n) noexcept { state_ += n * 0x9E3779B97F4A7C15ull; }
     /// Uniform in [0, 1).
     double uniform() noexcept { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
     /// Uniform in (0, 1].

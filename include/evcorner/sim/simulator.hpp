@@ -146,6 +146,11 @@ private:
     std::vector<double> bg_, cur_, next_;
     std::vector<double> lref_, ion_, ioff_;
     std::vector<float> con_, coff_;
+    // Thresholds and reference levels are set when a pixel first changes (ready_pixel()):
+    // ready_ says which are, thresholds_rng_ is the thresholds' stream at pixel 0.
+    std::vector<char> ready_;
+    Random thresholds_rng_{0};
+    void ready_pixel(std::size_t p);
     std::vector<std::int64_t> last_;
     std::vector<ObjectAcc> acc_;  // per object, its edge walk at the time being rendered
     // Per object: its pieces' polygons at the time being rendered (polys_) and at time_us()
