@@ -419,6 +419,16 @@ struct ArcStarAvx512 {
         const __m128i hi = _mm_insert_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(c)), *d, 1);
         return _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
     }
+    // The portable test for a circle outside the 32-bit range, out of line: inlined (as it
+    // was), it let GCC keep the circle's loads for it, so the batch loop moved half of them
+    // through general registers and the stack, and its AVX-512 code was 5x larger
+    // (docs/arcstar.md, "Speed").
+    template <int N, int Lmin, int Lmax, const auto& Circle>
+    [[gnu::noinline, gnu::cold]] static bool portable_fallback(const std::int64_t* centre, std::ptrdiff_t w,
+                                                               bool minority_only) noexcept {
+        return arcstar_circle_passes<N, Lmin, Lmax>(
+            centre, [w](int k) { return Circle[k].dy * w + Circle[k].dx; }, minority_only);
+    }
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m512i octet(__m256i lo, __m256i hi) noexcept {
         return _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1);
     }
@@ -434,8 +444,7 @@ struct ArcStarAvx512 {
         __mmask8 inexact = 0;
         const __m256i lo = relative(octet(q0, q1), vst, inexact), hi = relative(octet(q2, q3), vst, inexact);
         if (inexact != 0) [[unlikely]]
-            return arcstar_circle_passes<N, Lmin, Lmax>(
-                centre, [w](int k) { return kCircle3[k].dy * w + kCircle3[k].dx; }, minority_only);
+            return portable_fallback<N, Lmin, Lmax, kCircle3>(centre, w, minority_only);
         return passes<N, Lmin, Lmax>(Circle16{octet(lo, hi)}, minority_only);
     }
     /// The radius-4 test, the same way.
@@ -451,8 +460,7 @@ struct ArcStarAvx512 {
         __mmask8 inexact = 0;
         const __m256i a = relative(w0, vst, inexact), b = relative(w1, vst, inexact), c = relative(w2, vst, inexact);
         if (inexact != 0) [[unlikely]]
-            return arcstar_circle_passes<N, Lmin, Lmax>(
-                centre, [w](int k) { return kCircle4[k].dy * w + kCircle4[k].dx; }, minority_only);
+            return portable_fallback<N, Lmin, Lmax, kCircle4>(centre, w, minority_only);
         const __m512i v0 = octet(a, b);  // t[0..16)
         // t[16..20) into lanes 12..15, then t[16..20) t[0..12) and t[12..20) t[0..8).
         const __m512i c12 = _mm512_inserti32x4(v0, _mm256_castsi256_si128(c), 3);
