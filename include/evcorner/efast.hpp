@@ -21,6 +21,7 @@
 #include "evcorner/circle.hpp"
 #include "evcorner/corner_scores.hpp"
 #include "evcorner/detector.hpp"
+#include "evcorner/efast_avx512.hpp"
 #include "evcorner/event.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/sae.hpp"
@@ -165,7 +166,7 @@ private:
             const std::ptrdiff_t w = width;
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
             if constexpr (std::is_same_v<Search, Avx512Search>) {
-                return Avx512Search::circle16_fires(centre, off3) && Avx512Search::circle20_fires(centre, off4);
+                return efast_avx512::corner(centre, w * 8);
             } else
 #endif
             {

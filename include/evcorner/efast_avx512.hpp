@@ -1,0 +1,125 @@
+#pragma once
+// eFAST's AVX-512 per-event loads: the two circles of int64 SAE cells into the vector
+// layouts of Avx512Search (arc_test.hpp), addressed by rows.
+//
+// A circle pixel (dx, dy) lies at centre + dy * width + dx. The seven (radius 3) or nine
+// (radius 4) row pointers are formed from the centre and one or two loop-invariant row
+// strides, and every pixel is one load at a constant displacement from its row pointer.
+// The earlier form indexed a run-time table of 16 + 20 offsets: GCC 12 kept the offsets on
+// the stack and moved half of the pixels through a stack slot (load offset, load pixel,
+// store, reload into a vector): four instructions and a store-forwarding round trip per
+// pixel instead of one load. Pixels are paired into 128-bit lanes by vmovq + vmovhpd,
+// which read exactly the 8 bytes of each cell: a wider load over a row would cover cells
+// that the previous events have just written, and a load that spans a pending narrower
+// store cannot be forwarded (it waits until the store leaves the store buffer).
+// Only for code compiled for AVX-512 (efast.cpp's detect_avx512).
+
+#include <cstddef>
+#include <cstdint>
+
+#include "evcorner/arc_test.hpp"
+#include "evcorner/circle.hpp"
+#include "evcorner/cpu_paths.hpp"
+
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+// GCC 12 warns that the casts' undefined upper halves (_mm512_undefined_epi32) are used
+// uninitialised once inlined: they are overwritten by the inserts.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+namespace evcorner::efast_avx512 {
+
+// The rows y - R .. y + R around a centre, as three or five base pointers and the row
+// stride in bytes: row dy is one of them plus 0, 1 or 2 strides, which x86 addresses
+// directly (base + stride * scale + displacement), so that every pixel is one load and
+// only the stride (loop-invariant) and the bases occupy registers.
+template <int R>
+struct Rows {
+    const char* mid;    // row 0
+    const char* low;    // row -3
+    const char* high;   // row 3
+    const char* lower;  // row -4 (R = 4)
+    const char* higher; // row 4 (R = 4)
+    std::ptrdiff_t stride;
+    [[gnu::always_inline]] Rows(const std::int64_t* centre, std::ptrdiff_t stride_bytes, std::ptrdiff_t three_strides) noexcept
+        : mid(reinterpret_cast<const char*>(centre)), low(mid - three_strides), high(mid + three_strides),
+          lower(nullptr), higher(nullptr), stride(stride_bytes) {
+        if constexpr (R == 4) {
+            lower = low - stride;
+            higher = high + stride;
+        }
+    }
+    // The cell at (dx, dy) from the centre.
+    template <int Dx, int Dy>
+    [[gnu::always_inline]] const std::int64_t* at() const noexcept {
+        static_assert(-R <= Dy && Dy <= R && R <= 4);
+        const char* row;
+        if constexpr (Dy == -4) row = lower;
+        else if constexpr (Dy == -3) row = low;
+        else if constexpr (Dy == -2) row = low + stride;
+        else if constexpr (Dy == -1) row = low + 2 * stride;
+        else if constexpr (Dy == 0) row = mid;
+        else if constexpr (Dy == 1) row = mid + stride;
+        else if constexpr (Dy == 2) row = mid + 2 * stride;
+        else if constexpr (Dy == 3) row = high;
+        else row = higher;
+        return reinterpret_cast<const std::int64_t*>(row) + Dx;
+    }
+};
+
+// Pixels K and K+1 of a circle (kCircle3 / kCircle4) in the two 64-bit lanes of a 128-bit vector.
+template <const auto& Circle, int K, int R>
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline __m128i pair(const Rows<R>& r) noexcept {
+    const std::int64_t* a = r.template at<Circle[K].dx, Circle[K].dy>();
+    const std::int64_t* b = r.template at<Circle[K + 1].dx, Circle[K + 1].dy>();
+    const __m128d lo = _mm_castsi128_pd(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a)));
+    return _mm_castpd_si128(_mm_loadh_pd(lo, reinterpret_cast<const double*>(b)));
+}
+
+// Pixels K..K+3 in a 256-bit vector.
+template <const auto& Circle, int K, int R>
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline __m256i quad(const Rows<R>& r) noexcept {
+    return _mm256_inserti128_si256(_mm256_castsi128_si256(pair<Circle, K>(r)), pair<Circle, K + 2>(r), 1);
+}
+
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline __m512i join(__m256i lo, __m256i hi) noexcept {
+    return _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1);
+}
+
+/// The radius-3 circle around `centre` as Avx512Search::Circle16 (pixel k in lane k).
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline Avx512Search::Circle16 load16(
+    const Rows<3>& r) noexcept {
+    return {{join(quad<kCircle3, 0>(r), quad<kCircle3, 4>(r)), join(quad<kCircle3, 8>(r), quad<kCircle3, 12>(r))}};
+}
+
+/// The radius-4 circle around `centre` as Avx512Search::Circle20 (t[0..8), t[8..16),
+/// t[16..20) t[0..4), t[4..12)).
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline Avx512Search::Circle20 load20(
+    const Rows<4>& r) noexcept {
+    const __m256i q0 = quad<kCircle4, 0>(r), q4 = quad<kCircle4, 4>(r), q8 = quad<kCircle4, 8>(r);
+    const __m256i q12 = quad<kCircle4, 12>(r), q16 = quad<kCircle4, 16>(r);
+    return {{join(q0, q4), join(q8, q12), join(q16, q0), join(q4, q8)}};
+}
+
+/// eFAST's decision for an event away from the border, on the SAE plane just updated
+/// with it: the radius-3 circle fires with an arc of 3..6 and the radius-4 one with 4..8.
+/// `stride` is the row stride in bytes.
+// Not always_inline: it is called from View::process(), which has no target attribute;
+// detect_avx512's `flatten` inlines it there. (Tried: the radius-4 test out of line, as a
+// call, and with the stride made opaque once more before it so that its addresses are not
+// formed ahead of the radius-3 branch: both made the loop about 1.5x slower.)
+[[gnu::target(EVCORNER_AVX512_TARGET)]] inline bool corner(const std::int64_t* centre, std::ptrdiff_t stride) noexcept {
+    // Opaque to the optimiser at every event: else GCC hoists stride + displacement for
+    // each pixel out of the loop as an invariant of its own, and with 36 of them spills
+    // most to the stack, which is the cost this form removes.
+    __asm__ volatile("" : "+r"(stride));
+    const std::ptrdiff_t three_strides = 3 * stride;
+    return Avx512Search::fires<16, 3, 6>(load16(Rows<3>(centre, stride, three_strides))) &&
+           Avx512Search::fires<20, 4, 8>(load20(Rows<4>(centre, stride, three_strides)));
+}
+
+}  // namespace evcorner::efast_avx512
+#pragma GCC diagnostic pop
+#endif
