@@ -4,6 +4,7 @@
 # (../shared/data/real, when present), the bundled data/ and fuzz/seeds/. Fails on any
 # crash, sanitizer report, timeout (> 10 s per input) or allocation over 2 GB; the
 # reproducer is left in build-fuzz/artifacts/. Prints the executions per target.
+# FUZZ_JOBS targets (default: the number of cores) build and run at once.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 secs="${1:-60}"
@@ -11,11 +12,12 @@ root="$PWD"
 build="$root/build-fuzz"
 shared="$root/../shared/data/real"
 
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+# -g1: line tables, all the reports' stacks need (full -g costs build time for nothing more).
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG" -DCMAKE_CXX_COMPILER=clang++ \
   -DEVCORNER_FUZZ=ON -DEVCORNER_BUILD_APPS=OFF -DEVCORNER_BUILD_TESTS=OFF -DEVCORNER_BUILD_BENCH=OFF >/dev/null
 targets=(text csv aedat2 evt2 evt3 dat aedat4 hdf5 npy atis mat compressed)
 targets+=(mcap rosbag rosbag2)  # ROS bags, read in memory
-cmake --build "$build" -j "${FUZZ_JOBS:-2}" --target "${targets[@]/#/fuzz_}" >/dev/null
+cmake --build "$build" -j "${FUZZ_JOBS:-$(nproc)}" --target "${targets[@]/#/fuzz_}" >/dev/null
 
 # Seeds: the first 64 KiB of each matching file (inputs are capped at that length).
 seed() {  # seed TARGET FILE...
@@ -46,22 +48,35 @@ seed mat fuzz/seeds/*.mat "$shared"/rpg-event-lifetime/*.mat
 seed compressed fuzz/seeds/seed.txt.* fuzz/seeds/seed.csv.* fuzz/seeds/seed.csv fuzz/seeds/seed.npy
 
 mkdir -p "$build/artifacts" "$build/logs"
-failed=()
-for t in "${targets[@]}"; do
-  log="$build/logs/fuzz_$t.log"
-  extra=()
+# run_one TARGET: fuzzes one target; its exit status lands in logs/fuzz_TARGET.status.
+run_one() {
+  local t=$1 log="$build/logs/fuzz_$1.log" extra=()
   # libhdf5 (Debian 12: 1.10.8) is not robust against malformed files: it leaks, and
   # overflows its own buffers while parsing object headers (H5Aexists, H5Dread), inside
   # the library where evcorner cannot guard. fuzz_hdf5 runs and reports, but does not
   # fail the run; every other target does.
   [ "$t" = hdf5 ] && extra=(-detect_leaks=0)
   # A fixed seed by default, so that a CI run can be repeated; FUZZ_SEED=0 picks one at random.
-  if "$build/bin/fuzz_$t" "$build/corpus/$t" -max_total_time="$secs" -seed="${FUZZ_SEED:-1}" -rss_limit_mb=2048 -timeout=10 \
-       -max_len=65536 -print_final_stats=1 "${extra[@]}" -artifact_prefix="$build/artifacts/$t-" >"$log" 2>&1; then
-    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
+  local rc=0
+  "$build/bin/fuzz_$t" "$build/corpus/$t" -max_total_time="$secs" -seed="${FUZZ_SEED:-1}" -rss_limit_mb=2048 -timeout=10 \
+    -max_len=65536 -print_final_stats=1 "${extra[@]}" -artifact_prefix="$build/artifacts/$t-" >"$log" 2>&1 || rc=$?
+  echo "$rc" >"$build/logs/fuzz_$t.status"
+}
+# Each fuzzer is one process on one core: FUZZ_JOBS of them (default: the cores) run at once.
+jobs_max="${FUZZ_JOBS:-$(nproc)}"
+for t in "${targets[@]}"; do
+  rm -f "$build/logs/fuzz_$t.status"
+  while (( $(jobs -rp | wc -l) >= jobs_max )); do wait -n || true; done
+  run_one "$t" &
+done
+wait
+failed=()
+for t in "${targets[@]}"; do
+  log="$build/logs/fuzz_$t.log"
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
+  if [ "$(cat "$build/logs/fuzz_$t.status" 2>/dev/null)" = 0 ]; then
     echo "fuzz_$t: ok, $runs executions in ${secs} s"
   else
-    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
     if [ "$t" = hdf5 ]; then
       echo "fuzz_$t: crash after $runs executions (informational: see above; log: $log)" >&2
     else
