@@ -60,43 +60,28 @@ public:
         return process_unchecked(e);
     }
     /// process() without the check: `e` must be accepted by limits().
-    bool process_unchecked(const Event& e) noexcept {
-        note_time(e.t);
-        return View::make(*this).process<ScalarSearch>(e);
-    }
+    bool process_unchecked(const Event& e) noexcept { return View::make(*this).process<ScalarSearch>(e); }
 
     /// detect_unchecked() over a span with a chosen newest-pixel search (arc_test.hpp).
     template <class Search>
     std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-#ifdef EVCORNER_HAVE_AVX2_SEARCH
-        if constexpr (std::is_same_v<Search, Avx512Search>) {
-            // Every time the SAE holds is the time of an event this detector took: when all of
-            // them and this batch's lie within 2^30 - 1 us of each other, so does every fired
-            // pixel of every circle with its event, and the batch runs without the AVX-512
-            // test's per-circle range check (docs/arcstar.md, "Speed").
-            arcstar_time_span(events, span_lo_, span_hi_);
-            if (static_cast<std::uint64_t>(span_hi_) - static_cast<std::uint64_t>(span_lo_) <= kInRangeSpan)
-                return run_with<Search, true>(events, is_corner);
-            return run_with<Search, false>(events, is_corner);
-        } else
-#endif
-        {
-            forget_span();
-            return run_with<Search, false>(events, is_corner);
-        }
+        const View v = View::make(*this);
+        // The published parameters (filter on, never-fired passes) as compile-time constants:
+        // the per-event filter then carries no tests of parameters.
+        if (params_.filter && !params_.zero_init) return v.template run<Search, true>(events, is_corner);
+        return v.template run<Search, false>(events, is_corner);
     }
+
     /// process_unchecked() that also writes the event's score (corner_scores.hpp,
     /// docs/scores.md): computed for corner events only, NaN (kNoScore) for the others.
     /// The binary paths never compute it.
     bool process_scored_unchecked(const Event& e, double& score) noexcept {
-        note_time(e.t);
         return View::make(*this).process_scored<ScalarSearch>(e, score);
     }
     /// run_unchecked() with scores.
     template <class Search>
     std::size_t run_scored_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner,
                                      std::span<double> score) noexcept {
-        forget_span();
         const View v = View::make(*this);
         if (params_.filter && !params_.zero_init) return v.template run_scored<Search, true>(events, is_corner, score);
         return v.template run_scored<Search, false>(events, is_corner, score);
@@ -162,12 +147,10 @@ private:
         template <class Search>
         static constexpr bool kMovedBranches = false;
 #endif
-        // InRange (the AVX-512 loop only): every fired pixel of every circle lies within
-        // 2^30 - 1 us of its event (the AVX-512 test leaves its range check out).
-        template <class Search, bool Published, bool InRange>
+        template <class Search, bool Published>
         std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
             if constexpr (kMovedBranches<Search>) {
-                return run_moved<Search, Published, InRange>(events, is_corner);
+                return run_moved<Search, Published>(events, is_corner);
             } else {
                 std::size_t corners = 0;
                 for (std::size_t i = 0; i < events.size(); ++i) {
@@ -178,7 +161,7 @@ private:
                 return corners;
             }
         }
-        template <class Search, bool Published, bool InRange>
+        template <class Search, bool Published>
         std::size_t run_moved(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
             std::size_t corners = 0;
             const std::int64_t* cand_centre = nullptr;  // the pending candidate, if any
@@ -187,29 +170,19 @@ private:
             bool pending = false;
             const std::size_t n = events.size();
             bool pass_next = n != 0 && filter_event<Published>(events[0]);
-            // The planes lie one after the other (Sae): the event's plane by arithmetic, not a
-            // load indexed by polarity. The border as two unsigned compares, one branch.
-            std::int64_t* const plane0 = plane[0];
-            const std::ptrdiff_t second = plane[1] - plane[0];
-            const auto inner = [](std::ptrdiff_t side) {
-                return static_cast<std::uint32_t>(side > 2 * kCircleMargin ? side - 2 * kCircleMargin : 0);
-            };
-            const std::uint32_t inner_w = inner(width), inner_h = inner(height);
             for (std::size_t i = 0; i < n; ++i) {
                 const Event& e = events[i];
                 is_corner[i] = 0;
                 const bool pass = pass_next;
                 if (i + 1 < n) pass_next = filter_event<Published>(events[i + 1]);
                 if (!pass) continue;
-                const std::ptrdiff_t p = e.p & 1;
+                const int p = e.p & 1;
                 const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
                 const std::int64_t st = Sae::stored(e.t);
-                std::int64_t* const centre = plane0 + (at + (-p & second));
-                const bool in = (static_cast<std::uint32_t>(e.x - kCircleMargin) < inner_w) &
-                                (static_cast<std::uint32_t>(e.y - kCircleMargin) < inner_h);
-                const bool r3 = in && circles.pass_circle<Search, 16, kArc3Min, kArc3Max, InRange>(centre, st, minority_only);
+                std::int64_t* const centre = plane[p] + at;
+                const bool r3 = inside(e) && circles.pass_circle<Search, 16, kArc3Min, kArc3Max>(centre, st, minority_only);
                 if (pending) {
-                    const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max, InRange>(cand_centre, cand_st, minority_only);
+                    const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max>(cand_centre, cand_st, minority_only);
                     is_corner[cand] = static_cast<std::uint8_t>(c);
                     corners += c;
                 }
@@ -220,7 +193,7 @@ private:
                 cand = i;
             }
             if (pending) {
-                const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max, InRange>(cand_centre, cand_st, minority_only);
+                const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max>(cand_centre, cand_st, minority_only);
                 is_corner[cand] = static_cast<std::uint8_t>(c);
                 corners += c;
             }
@@ -291,32 +264,9 @@ private:
         }
     };
 
-    template <class Search, bool InRange>
-    std::size_t run_with(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-        const View v = View::make(*this);
-        // The published parameters (filter on, never-fired passes) as compile-time constants:
-        // the per-event filter then carries no tests of parameters.
-        if (params_.filter && !params_.zero_init) return v.template run<Search, true, InRange>(events, is_corner);
-        return v.template run<Search, false, InRange>(events, is_corner);
-    }
-
-    // The span of the times of every event taken (lo > hi: none yet); widened to the whole
-    // range (never in range again) by the entry points that do not keep it. A bound of
-    // every time the SAE can hold, for the AVX-512 batch loop's range decision.
-    static constexpr std::uint64_t kInRangeSpan = (std::uint64_t{1} << 30) - 1;
-    void note_time(std::int64_t t) noexcept {
-        span_lo_ = t < span_lo_ ? t : span_lo_;
-        span_hi_ = t > span_hi_ ? t : span_hi_;
-    }
-    void forget_span() noexcept {
-        span_lo_ = INT64_MIN;
-        span_hi_ = INT64_MAX;
-    }
-
     Params params_;
     Sae sae_;
     ZeroedArray<ArcStarLatest> latest_;
-    std::int64_t span_lo_ = INT64_MAX, span_hi_ = INT64_MIN;
 };
 static_assert(Detector<ArcStar>);
 static_assert(ScoredDetector<ArcStar>);

@@ -16,15 +16,13 @@
 //   passes iff the final size is within Lmin..Lmax or (unless minority_only) within
 //   N-Lmax..N-Lmin.
 
-#include <cstddef>
 #include <cstdint>
-#include <span>
+
 #include <type_traits>
 #include <utility>
 
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
-#include "evcorner/event.hpp"
 #include "evcorner/sae.hpp"
 
 namespace evcorner {
@@ -402,7 +400,7 @@ struct ArcStarAvx512 {
         // d within [-kRange + 1, kRange - 1]  <=>  unsigned(d - (-kRange + 1)) <= 2 kRange - 2
         const __m512i u = _mm512_sub_epi64(d, _mm512_set1_epi64(-kRange + 1));
         inexact |= _mm512_mask_cmpgt_epu64_mask(_mm512_test_epi64_mask(q, q), u, _mm512_set1_epi64(2 * kRange - 2));
-        return relative_in_range(q, st);  // (the same d: the compiler computes it once)
+        return _mm256_max_epi32(_mm512_cvtsepi64_epi32(d), _mm256_set1_epi32(-static_cast<std::int32_t>(kRange)));
     }
 
     // Pixels K..K+3 of a circle (array of Offset) around `centre` in a row of width `w`, as
@@ -434,25 +432,8 @@ struct ArcStarAvx512 {
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m512i octet(__m256i lo, __m256i hi) noexcept {
         return _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1);
     }
-    // relative() for a caller that knows the event and every fired pixel of the circle lie
-    // within 2^30 - 1 us of each other (InRange): the same lanes, without the range check.
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i relative_in_range(__m512i q, __m512i st) noexcept {
-        constexpr std::int32_t kRange = std::int32_t{1} << 30;
-        return _mm256_max_epi32(_mm512_cvtsepi64_epi32(_mm512_sub_epi64(q, st)), _mm256_set1_epi32(-kRange));
-    }
-    // relative() or relative_in_range().
-    template <bool InRange>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i relative(__m512i q, __m512i st,
-                                                                        __mmask8& inexact) noexcept {
-        if constexpr (InRange) return relative_in_range(q, st);
-        else return relative(q, st, inexact);
-    }
 
     /// The radius-3 test around `centre` (rows `w` cells wide) for an event of stored time st.
-    /// InRange: the caller knows that every fired pixel of the circle lies within 2^30 - 1 us
-    /// of the event (ArcStar's batch loop, from the span of all times it has taken), so the
-    /// range check and its fallback are left out.
-    template <bool InRange = false>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle16_passes(const std::int64_t* centre,
                                                                             std::ptrdiff_t w, std::int64_t st,
                                                                             bool minority_only) noexcept {
@@ -461,14 +442,12 @@ struct ArcStarAvx512 {
         const __m256i q2 = quad<kCircle3, 8>(centre, w), q3 = quad<kCircle3, 12>(centre, w);
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;
-        const __m256i lo = relative<InRange>(octet(q0, q1), vst, inexact);
-        const __m256i hi = relative<InRange>(octet(q2, q3), vst, inexact);
-        if (!InRange && inexact != 0) [[unlikely]]
+        const __m256i lo = relative(octet(q0, q1), vst, inexact), hi = relative(octet(q2, q3), vst, inexact);
+        if (inexact != 0) [[unlikely]]
             return portable_fallback<N, Lmin, Lmax, kCircle3>(centre, w, minority_only);
         return passes<N, Lmin, Lmax>(Circle16{octet(lo, hi)}, minority_only);
     }
     /// The radius-4 test, the same way.
-    template <bool InRange = false>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool circle20_passes(const std::int64_t* centre,
                                                                             std::ptrdiff_t w, std::int64_t st,
                                                                             bool minority_only) noexcept {
@@ -479,9 +458,8 @@ struct ArcStarAvx512 {
         const __m512i w0 = octet(q0, q1), w1 = octet(q2, q3), w2 = octet(q4, q0);
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;
-        const __m256i a = relative<InRange>(w0, vst, inexact), b = relative<InRange>(w1, vst, inexact);
-        const __m256i c = relative<InRange>(w2, vst, inexact);
-        if (!InRange && inexact != 0) [[unlikely]]
+        const __m256i a = relative(w0, vst, inexact), b = relative(w1, vst, inexact), c = relative(w2, vst, inexact);
+        if (inexact != 0) [[unlikely]]
             return portable_fallback<N, Lmin, Lmax, kCircle4>(centre, w, minority_only);
         const __m512i v0 = octet(a, b);  // t[0..16)
         // t[16..20) into lanes 12..15, then t[16..20) t[0..12) and t[12..20) t[0..8).
@@ -491,30 +469,6 @@ struct ArcStarAvx512 {
         return passes<N, Lmin, Lmax>(Circle20{{v0, v1, v2}}, minority_only);
     }
 };
-
-/// The smallest and largest time of `events` merged into lo and hi (lo > hi for none):
-/// four events per AVX-512 load (Event is 16 bytes, its time first). For the batch loop's
-/// range decision (ArcStar::run_unchecked).
-[[gnu::target(EVCORNER_AVX512_TARGET)]] inline void arcstar_time_span(std::span<const Event> events, std::int64_t& lo,
-                                                                      std::int64_t& hi) noexcept {
-    static_assert(sizeof(Event) == 16 && offsetof(Event, t) == 0);
-    constexpr __mmask8 kTimes = 0x55;  // lanes 0, 2, 4, 6: the times of the four events
-    const std::size_t n = events.size();
-    const auto* base = reinterpret_cast<const std::byte*>(events.data());
-    __m512i vlo = _mm512_set1_epi64(lo), vhi = _mm512_set1_epi64(hi);
-    std::size_t i = 0;
-    for (; i + 4 <= n; i += 4) {
-        const __m512i v = _mm512_loadu_si512(base + i * sizeof(Event));
-        vlo = _mm512_mask_min_epi64(vlo, kTimes, vlo, v);
-        vhi = _mm512_mask_max_epi64(vhi, kTimes, vhi, v);
-    }
-    lo = _mm512_reduce_min_epi64(vlo);
-    hi = _mm512_reduce_max_epi64(vhi);
-    for (; i < n; ++i) {
-        lo = events[i].t < lo ? events[i].t : lo;
-        hi = events[i].t > hi ? events[i].t : hi;
-    }
-}
 #pragma GCC diagnostic pop
 #endif
 
@@ -534,16 +488,14 @@ public:
     /// One circle's test alone (N = 16: radius 3, N = 20: radius 4), for an event of stored
     /// time `st` at `centre`. Reads only the circle, not the centre: the event's own write
     /// may come before or after it.
-    /// InRange (AVX-512 only; ignored by the other searches): the caller knows that every
-    /// fired pixel of the circle lies within 2^30 - 1 us of `st`.
-    template <class Search, int N, int Lmin, int Lmax, bool InRange = false>
+    template <class Search, int N, int Lmin, int Lmax>
     [[nodiscard]] bool pass_circle(const std::int64_t* centre, std::int64_t st, bool minority_only) const noexcept {
         static_assert(N == 16 || N == 20);
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
         if constexpr (std::is_same_v<Search, Avx512Search>) {
             static_assert((N == 16 && Lmin == 3 && Lmax == 6) || (N == 20 && Lmin == 4 && Lmax == 8));
-            if constexpr (N == 16) return ArcStarAvx512::circle16_passes<InRange>(centre, width_, st, minority_only);
-            else return ArcStarAvx512::circle20_passes<InRange>(centre, width_, st, minority_only);
+            if constexpr (N == 16) return ArcStarAvx512::circle16_passes(centre, width_, st, minority_only);
+            else return ArcStarAvx512::circle20_passes(centre, width_, st, minority_only);
         } else
 #endif
         {
