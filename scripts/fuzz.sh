@@ -73,7 +73,7 @@ wait
 failed=()
 for t in "${targets[@]}"; do
   log="$build/logs/fuzz_$t.log"
-  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -n 1 || echo '?')
   if [ "$(cat "$build/logs/fuzz_$t.status" 2>/dev/null)" = 0 ]; then
     echo "fuzz_$t: ok, $runs executions in ${secs} s"
   else
