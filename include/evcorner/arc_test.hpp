@@ -177,11 +177,7 @@ struct Avx2Search {
 /// and no arc growth. Only for code compiled for AVX-512.
 // GCC 12 warns that the intrinsics' own pass-through operand (_mm512_undefined_epi32) is
 // used uninitialised once they are inlined: it is never read (the mask is all ones).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+EVCORNER_AVX512_WARNINGS_OFF
 struct Avx512Search {
     // A 16-pixel circle in two vectors: t[0..8), t[8..16).
     struct Circle16 {
@@ -290,7 +286,7 @@ struct Avx512Search {
         return fires<20, 4, 8>(load20(centre, offsets));
     }
 };
-#pragma GCC diagnostic pop
+EVCORNER_AVX512_WARNINGS_ON
 #endif
 
 /// Gathers the circle around `centre` (pixel k at centre[offset(k)]) and runs the test.

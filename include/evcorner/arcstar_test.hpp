@@ -23,6 +23,7 @@
 
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
+#include "evcorner/cpu_paths.hpp"
 #include "evcorner/sae.hpp"
 
 namespace evcorner {
@@ -274,11 +275,7 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
 /// pixel of the circle lies within +-(2^30 - 1) us (17.9 minutes) of the event;
 /// never-fired pixels become -2^30, older than all of them. A circle outside that range
 /// (never on the real files) takes the portable test (arcstar_circle_passes).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+EVCORNER_AVX512_WARNINGS_OFF
 struct ArcStarAvx512 {
     // Values per pixel of a 16-pixel circle: one register of 32-bit lanes.
     struct Lanes16 {
@@ -469,7 +466,7 @@ struct ArcStarAvx512 {
         return passes<N, Lmin, Lmax>(Circle20{{v0, v1, v2}}, minority_only);
     }
 };
-#pragma GCC diagnostic pop
+EVCORNER_AVX512_WARNINGS_ON
 #endif
 
 /// Both Arc* circles around a pixel of an SAE plane `width` cells wide: the radius-3

@@ -25,6 +25,7 @@
 
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
+#include "evcorner/cpu_paths.hpp"
 
 namespace evcorner {
 
@@ -187,11 +188,7 @@ inline int gather_doubled(const std::int64_t* centre, std::ptrdiff_t width, cons
 // not empty (the definition's shortest firing arc), s = its one start (the L newest pixels
 // are one set, so one arc), and the arc's oldest and the rest's newest are masked
 // reductions. Only for code compiled for AVX-512 (the scored AVX-512 loop of efast.cpp).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+EVCORNER_AVX512_WARNINGS_OFF
 struct Avx512Scored {
     using C16 = Avx512Search::Circle16;
     using C20 = Avx512Search::Circle20;
@@ -261,7 +258,7 @@ struct Avx512Scored {
         return {len, time_margin(reduce<false>(t, arc), reduce<true>(t, ~arc & kAll), now)};
     }
 };
-#pragma GCC diagnostic pop
+EVCORNER_AVX512_WARNINGS_ON
 #endif
 
 inline double combine(ArcExtent c3, ArcExtent c4) noexcept {

@@ -24,11 +24,7 @@
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
 // GCC 12 warns that the casts' undefined upper halves (_mm512_undefined_epi32) are used
 // uninitialised once inlined: they are overwritten by the inserts.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+EVCORNER_AVX512_WARNINGS_OFF
 namespace evcorner::efast_avx512 {
 
 // The rows y - R .. y + R around a centre, as three or five base pointers and the row
@@ -121,5 +117,5 @@ template <const auto& Circle, int K, int R>
 }
 
 }  // namespace evcorner::efast_avx512
-#pragma GCC diagnostic pop
+EVCORNER_AVX512_WARNINGS_ON
 #endif
