@@ -77,7 +77,10 @@ template <const auto& Circle, int K, int R>
 // Pixels K..K+3 in a 256-bit vector.
 template <const auto& Circle, int K, int R>
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline __m256i quad(const Rows<R>& r) noexcept {
-    return _mm256_inserti128_si256(_mm256_castsi128_si256(pair<Circle, K>(r)), pair<Circle, K + 2>(r), 1);
+    // Named first: clang defines _mm256_inserti128_si256 as a macro, which would split the
+    // template arguments' commas into macro arguments.
+    const __m128i lo = pair<Circle, K>(r), hi = pair<Circle, K + 2>(r);
+    return _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
 }
 
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline __m512i join(__m256i lo, __m256i hi) noexcept {
