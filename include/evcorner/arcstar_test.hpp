@@ -24,6 +24,7 @@
 #include "evcorner/arc_test.hpp"
 #include "evcorner/circle.hpp"
 #include "evcorner/cpu_paths.hpp"
+#include "evcorner/efast_avx512.hpp"
 #include "evcorner/sae.hpp"
 
 namespace evcorner {
@@ -400,21 +401,18 @@ struct ArcStarAvx512 {
         return _mm256_max_epi32(_mm512_cvtsepi64_epi32(d), _mm256_set1_epi32(-static_cast<std::int32_t>(kRange)));
     }
 
-    // Pixels K..K+3 of a circle (array of Offset) around `centre` in a row of width `w`, as
-    // 64-bit lanes. Each address is centre + dy * w + dx with dy, dx constants, so the loads
-    // need no offset table (which the loop would keep on the stack), and each goes straight
-    // into a vector register (vmovq / vpinsrq from memory).
-    template <const auto& Circle, int K>
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i quad(const std::int64_t* centre,
-                                                                     std::ptrdiff_t w) noexcept {
-        const auto pair = [centre, w](int k) {
-            return std::pair{centre + Circle[k].dy * w + Circle[k].dx, centre + Circle[k + 1].dy * w + Circle[k + 1].dx};
-        };
-        const auto [a, b] = pair(K);
-        const auto [c, d] = pair(K + 2);
-        const __m128i lo = _mm_insert_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a)), *b, 1);
-        const __m128i hi = _mm_insert_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(c)), *d, 1);
-        return _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+    // The circles' pixels are loaded by rows, as eFAST's AVX-512 path does
+    // (efast_avx512.hpp): every pixel is one load at a constant displacement from one of
+    // three (radius 3) or five (radius 4) row pointers plus 0, 1 or 2 row strides. The
+    // stride is made opaque to the optimiser at every test (row_stride()): else GCC hoists
+    // dy * width + dx for each of the 36 pixels out of the batch loop as an invariant of
+    // its own and keeps most of them on the stack, so that every pixel cost a reload of its
+    // offset before its load (main's loop before wt-arc7: 14 of the radius-3 block's 129
+    // instructions).
+    [[gnu::always_inline]] static inline std::ptrdiff_t row_stride(std::ptrdiff_t w) noexcept {
+        std::ptrdiff_t stride = w * static_cast<std::ptrdiff_t>(sizeof(std::int64_t));
+        __asm__ volatile("" : "+r"(stride));
+        return stride;
     }
     // The portable test for a circle outside the 32-bit range, out of line: inlined (as it
     // was), it let GCC keep the circle's loads for it, so the batch loop moved half of them
@@ -435,8 +433,10 @@ struct ArcStarAvx512 {
                                                                             std::ptrdiff_t w, std::int64_t st,
                                                                             bool minority_only) noexcept {
         constexpr int N = 16, Lmin = 3, Lmax = 6;
-        const __m256i q0 = quad<kCircle3, 0>(centre, w), q1 = quad<kCircle3, 4>(centre, w);
-        const __m256i q2 = quad<kCircle3, 8>(centre, w), q3 = quad<kCircle3, 12>(centre, w);
+        const std::ptrdiff_t stride = row_stride(w);
+        const efast_avx512::Rows<3> r(centre, stride, 3 * stride);
+        const __m256i q0 = efast_avx512::quad<kCircle3, 0>(r), q1 = efast_avx512::quad<kCircle3, 4>(r);
+        const __m256i q2 = efast_avx512::quad<kCircle3, 8>(r), q3 = efast_avx512::quad<kCircle3, 12>(r);
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;
         const __m256i lo = relative(octet(q0, q1), vst, inexact), hi = relative(octet(q2, q3), vst, inexact);
@@ -449,9 +449,11 @@ struct ArcStarAvx512 {
                                                                             std::ptrdiff_t w, std::int64_t st,
                                                                             bool minority_only) noexcept {
         constexpr int N = 20, Lmin = 4, Lmax = 8;
-        const __m256i q0 = quad<kCircle4, 0>(centre, w), q1 = quad<kCircle4, 4>(centre, w);
-        const __m256i q2 = quad<kCircle4, 8>(centre, w), q3 = quad<kCircle4, 12>(centre, w);
-        const __m256i q4 = quad<kCircle4, 16>(centre, w);
+        const std::ptrdiff_t stride = row_stride(w);
+        const efast_avx512::Rows<4> r(centre, stride, 3 * stride);
+        const __m256i q0 = efast_avx512::quad<kCircle4, 0>(r), q1 = efast_avx512::quad<kCircle4, 4>(r);
+        const __m256i q2 = efast_avx512::quad<kCircle4, 8>(r), q3 = efast_avx512::quad<kCircle4, 12>(r);
+        const __m256i q4 = efast_avx512::quad<kCircle4, 16>(r);
         const __m512i w0 = octet(q0, q1), w1 = octet(q2, q3), w2 = octet(q4, q0);
         const __m512i vst = _mm512_set1_epi64(st);
         __mmask8 inexact = 0;

@@ -12,7 +12,8 @@
 // which read exactly the 8 bytes of each cell: a wider load over a row would cover cells
 // that the previous events have just written, and a load that spans a pending narrower
 // store cannot be forwarded (it waits until the store leaves the store buffer).
-// Only for code compiled for AVX-512 (efast.cpp's detect_avx512).
+// Only for code compiled for AVX-512 (efast.cpp's detect_avx512; Arc*'s AVX-512 test,
+// ArcStarAvx512 in arcstar_test.hpp, loads its circles through Rows and quad() too).
 
 #include <cstddef>
 #include <cstdint>
