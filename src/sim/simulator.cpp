@@ -222,34 +222,44 @@ struct Simulator::AccSink {
     std::size_t mwords;
     int w, h;
 
-    void add_pair(int r, int k, double v0, double v1, double w0, double w1) {
-        const std::size_t row = static_cast<std::size_t>(r - y0);
-        const std::size_t c = static_cast<std::size_t>(k - x0);
-        const std::size_t cell = row * cells + c;
-        cov[cell] += v0;
-        cov[cell + 1] += v1;
-        if constexpr (Dual) {
-            val[cell] += w0;
-            val[cell + 1] += w1;
+    // Row r's part: pointers to its first window cell, written bits and marks, so that the
+    // walk's pieces in the row (contiguous columns) index from registers.
+    struct Row {
+        double* cov;
+        double* val;
+        std::uint64_t* written;
+        std::uint64_t* marks;
+        int x0;
+        void add_pair(int k, double v0, double v1, double w0, double w1) noexcept {
+            const std::size_t c = static_cast<std::size_t>(k - x0);
+            cov[c] += v0;
+            cov[c + 1] += v1;
+            if constexpr (Dual) {
+                val[c] += w0;
+                val[c + 1] += w1;
+            }
+            if constexpr (Moving) {
+                marks[static_cast<unsigned>(k) >> 6] |= std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
+            } else {
+                std::uint64_t* wr = written + (c >> 6);
+                const unsigned bit = static_cast<unsigned>(c) & 63u;
+                wr[0] |= std::uint64_t{3} << bit;  // cells c and c + 1 (the latter in the next word when bit is 63)
+                if (bit == 63) wr[1] |= 1;
+            }
         }
-        if constexpr (Moving) {
-            marks[static_cast<std::size_t>(r) * mwords + (static_cast<unsigned>(k) >> 6)] |=
-                std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
-        } else {
-            std::uint64_t* wr = written + row * words + (c >> 6);
-            const unsigned bit = static_cast<unsigned>(c) & 63u;
-            wr[0] |= std::uint64_t{3} << bit;  // cells c and c + 1 (the latter in the next word when bit is 63)
-            if (bit == 63) wr[1] |= 1;
+        // A single addition (at column 0, for the part of an edge left of the sensor, which
+        // covers no pixel of its own).
+        void add(int k, double v, double w2) noexcept {
+            const std::size_t c = static_cast<std::size_t>(k - x0);
+            cov[c] += v;
+            if constexpr (Dual) val[c] += w2;
+            if constexpr (!Moving) written[c >> 6] |= std::uint64_t{1} << (c & 63u);
         }
-    }
-    // A single addition (at column 0, for the part of an edge left of the sensor, which
-    // covers no pixel of its own).
-    void add(int r, int k, double v, double w2) {
-        const std::size_t row = static_cast<std::size_t>(r - y0);
-        const std::size_t c = static_cast<std::size_t>(k - x0);
-        cov[row * cells + c] += v;
-        if constexpr (Dual) val[row * cells + c] += w2;
-        if constexpr (!Moving) written[row * words + (c >> 6)] |= std::uint64_t{1} << (c & 63u);
+    };
+    Row row(int r) const noexcept {
+        const std::size_t wrow = static_cast<std::size_t>(r - y0);
+        return {cov + wrow * cells, Dual ? val + wrow * cells : nullptr, Moving ? nullptr : written + wrow * words,
+                Moving ? marks + static_cast<std::size_t>(r) * mwords : nullptr, x0};
     }
     void span(int r, double, double) noexcept {
         if (r < my0) my0 = r;
@@ -317,8 +327,9 @@ void Simulator::render(bool all_rows) {
         dirty_y1_ = h_ - 1;
     } else {
         // The pixels the moving edges pass through now (cur_marks_, marked by their edge
-        // walks) and at time_us() (prev_marks_, kept from the step that reached it).
-        for (int y = cur_y0_; y <= cur_y1_; ++y) std::fill_n(row_bits(cur_marks_, y), words_, 0);
+        // walks) and at time_us() (prev_marks_, kept from the step that reached it). cur_marks_
+        // is all zero here: the union below clears prev_marks_ as it reads it, and the two
+        // swap after the step.
         cur_y0_ = h_;
         cur_y1_ = -1;
         for (std::size_t o = 0; o < rects_.size(); ++o)
@@ -332,8 +343,11 @@ void Simulator::render(bool all_rows) {
         std::uint64_t* d = row_bits(dirty_, y);
         if (!all_rows) {
             const std::uint64_t* c = row_bits(cur_marks_, y);
-            const std::uint64_t* p = row_bits(prev_marks_, y);
-            for (std::size_t k = 0; k < words_; ++k) d[k] = c[k] | p[k];
+            std::uint64_t* p = row_bits(prev_marks_, y);
+            for (std::size_t k = 0; k < words_; ++k) {
+                d[k] = c[k] | p[k];
+                p[k] = 0;  // read for the last time (cleared here rather than in a pass of its own)
+            }
         }
         const std::size_t base = static_cast<std::size_t>(y) * w;
         for (std::size_t k = 0; k < words_; ++k)
