@@ -32,7 +32,7 @@ struct DenseSink {
         const std::size_t i = static_cast<std::size_t>(r) * stride;
         return {acc + i, Dual ? acc2 + i : nullptr};
     }
-    void span(int, double, double) noexcept {}
+    void rows(int, int) noexcept {}
     void flat(double, double, double) noexcept {}
 };
 

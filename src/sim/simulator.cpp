@@ -72,7 +72,7 @@ Simulator::Simulator(Scene scene)
       end_(static_cast<double>(scene_.duration_us())),
       noise_rng_(scene_.seed, kSaltNoise) {
     const std::size_t n = static_cast<std::size_t>(scene_.sensor.pixels());
-    // Pixels, accumulator cells and bitmap bits are indexed with 32 bits (Term, changed_).
+    // Pixels, accumulator cells and bitmap bits are indexed with 32 bits.
     if (std::max(stride_, words_ * 64) * static_cast<std::size_t>(h_) > UINT32_MAX)
         throw std::length_error("simulate: a " + std::to_string(w_) + "x" + std::to_string(h_) +
                                 " sensor is too large for the simulator (at most about 4.29e9 pixels)");
@@ -261,9 +261,9 @@ struct Simulator::AccSink {
         return {cov + wrow * cells, Dual ? val + wrow * cells : nullptr, Moving ? nullptr : written + wrow * words,
                 Moving ? marks + static_cast<std::size_t>(r) * mwords : nullptr, x0};
     }
-    void span(int r, double, double) noexcept {
-        if (r < my0) my0 = r;
-        if (r > my1) my1 = r;
+    void rows(int r0, int r1) noexcept {
+        if (r0 < my0) my0 = r0;
+        if (r1 > my1) my1 = r1;
     }
     void flat(double y, double xl, double xr) noexcept {
         if (!Moving || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
@@ -273,10 +273,8 @@ struct Simulator::AccSink {
         const int hi = hi_x >= w - 1 ? w - 1 : static_cast<int>(hi_x);
         const int r0 = std::max(0, static_cast<int>(std::floor(y - kMarkMargin)));
         const int r1 = std::min(h - 1, static_cast<int>(std::floor(y + kMarkMargin)));
-        for (int r = r0; r <= r1; ++r) {
-            set_range(marks + static_cast<std::size_t>(r) * mwords, lo, hi);
-            span(r, xl, xr);
-        }
+        for (int r = r0; r <= r1; ++r) set_range(marks + static_cast<std::size_t>(r) * mwords, lo, hi);
+        if (r0 <= r1) rows(r0, r1);
     }
 };
 
@@ -442,22 +440,6 @@ void Simulator::render(bool all_rows) {
             }
         }
     }
-    // The dirty pixels that changed.
-    changed_.resize(cur_.size());  // room for every pixel (only the first nc are kept)
-    std::uint32_t* ch = changed_.data();
-    std::size_t nc = 0;
-    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
-        const std::uint64_t* d = row_bits(dirty_, y);
-        const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (std::size_t k = 0; k < words_; ++k)
-            for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
-                const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                // Without branches: every dirty pixel's index is written, kept when it changed.
-                ch[nc] = static_cast<std::uint32_t>(i);
-                nc += cur_[i] != next_[i] ? 1 : 0;
-            }
-    }
-    changed_n_ = nc;
 }
 
 double Simulator::max_displacement() const noexcept {
@@ -648,10 +630,14 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     }
     double worst = 0;
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
-    for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
-        const std::size_t p = pix;
-        if (ready_[p] == 0) ready_pixel(p);
+    // The dirty pixels (render()) in row-major order; those whose value changed go on. Read
+    // from the bitmap here rather than listed by render() in a pass of their own.
+    std::size_t changed = 0;
+    auto pixel = [&](std::size_t p) {
         const double a = cur_[p], b = next_[p];
+        if (a == b) return;
+        ++changed;
+        if (ready_[p] == 0) ready_pixel(p);
         cur_[p] = b;
         const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
         const bool had_history = hist_step_[p] == step_index;
@@ -660,11 +646,11 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         hist_step_[p] = step_index + 1;
         if (d > limit_ * den) {
             refine(p, 0, kKeyEnd, a, b, false, ev);
-            continue;
+            return;
         }
         worst = std::max(worst, d / den);
         // Most pixels do not cross: nothing to do but note the change.
-        if (b > a ? b < ion_[p] : b > ioff_[p]) continue;
+        if (b > a ? b < ion_[p] : b > ioff_[p]) return;
         // A crossing. Where the pixel also changed in the step before, the parabola through
         // its three values tells how far the crossing's time would move if I bends like it;
         // within the tolerance the straight line is kept without a sample. A pixel that
@@ -679,11 +665,20 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
             const double shift = std::abs(c * u * (u - 1.0) / (b - a)) * step_len_;
             if (shift <= crossing_tol_us_) {
                 cross(p, t0, t1, a, b, ev);
-                continue;
+                return;
             }
         }
         refine(p, 0, kKeyEnd, a, b, false, ev);
+    };
+    const std::size_t w = static_cast<std::size_t>(w_);
+    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
+        const std::uint64_t* dm = row_bits(dirty_, y);
+        const std::size_t base = static_cast<std::size_t>(y) * w;
+        for (std::size_t k = 0; k < words_; ++k)
+            for (std::uint64_t m = dm[k]; m != 0; m &= m - 1)
+                pixel(base + k * 64 + static_cast<std::size_t>(std::countr_zero(m)));
     }
+    changed_n_ = changed;
     stats_.max_step_change = std::max(stats_.max_step_change, worst / scene_.camera.contrast);
 }
 

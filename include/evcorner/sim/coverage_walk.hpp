@@ -6,16 +6,17 @@
 // Each edge is cut at the row and column lines into pieces lying in one cell; a piece with
 // signed height h (the edge's y-extent in the cell, positive upwards) and mean x xm in cell
 // column k adds h (k + 1 - xm) to its own cell and h (xm - k) to the next one. The sink gets:
-//   sink.row(r)             a row sink for row r (made once per row an edge crosses, after
-//                           span(); it keeps the row's pointers in registers), on which:
+//   sink.row(r)             a row sink for row r (made once per row an edge crosses; it
+//                           keeps the row's pointers in registers), on which:
 //     row.add(k, v, v2)     add v at column k (and v2 into the second array when Dual)
 //     row.add_pair(k, v0, v1, w0, w1)   add v0 at column k, then v1 at column k + 1 (and
 //                           w0, w1 into the second array when Dual)
-//   sink.span(r, xl, xr)    a slanted edge crosses row r between x = xl and x = xr
+//   sink.rows(r0, r1)       a slanted edge crosses rows r0 .. r1 (called once per edge, before
+//                           its rows' additions; not called when it crosses none)
 //   sink.flat(y, xl, xr)    a horizontal edge at y from x = xl to x = xr (it adds nothing)
 // Parts left of x = 0 add to column 0, parts right of x = width and outside rows
-// [0, height) add nothing; span() is called for every row in [0, height) an edge crosses,
-// wherever it lies in x.
+// [0, height) add nothing; rows() gets every row in [0, height) an edge crosses, wherever it
+// lies in x.
 
 #include <algorithm>
 #include <cmath>
@@ -34,6 +35,9 @@ void walk_coverage_edge(double x0, double y0, double x1, double y1, double sign,
     const double dxdy = (x1 - x0) / (y1 - y0);
     const int r0 = std::max(0, static_cast<int>(std::floor(y0)));
     const int r1 = std::min(height - 1, static_cast<int>(std::ceil(y1)) - 1);
+    // Every row r0 .. r1 is crossed: r0 <= y0 < r0 + 1 (or r0 = 0 and y0 < 0 < y1) and
+    // r1 < y1, so each row's part [ya, yb] below has yb > ya.
+    if (r0 <= r1) sink.rows(r0, r1);
     for (int r = r0; r <= r1; ++r) {
         const double ya = std::max(y0, static_cast<double>(r));
         const double yb = std::min(y1, static_cast<double>(r + 1));
@@ -42,7 +46,6 @@ void walk_coverage_edge(double x0, double y0, double x1, double y1, double sign,
         const double h2 = Dual ? sign2 * (yb - ya) : 0.0;
         const double xa = x0 + (ya - y0) * dxdy, xb = x0 + (yb - y0) * dxdy;
         const double xl = std::min(xa, xb), xr = std::max(xa, xb);
-        sink.span(r, xl, xr);
         auto row = sink.row(r);
         if (xr <= 0) {  // wholly left of the sensor: covers every pixel of the row to its right
             row.add(0, h, h2);
