@@ -377,9 +377,15 @@ void Simulator::render(bool all_rows) {
         ObjectAcc& acc = acc_[o];
         const std::size_t cells = acc.words * 64;
         const std::size_t kw = static_cast<std::size_t>(acc.x0) / 64;  // the window's first sensor word
-        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row).
+        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row),
+        // and the columns just outside them that its walk may write by rounding (r.x0 - 1 and
+        // r.x1 + 1, r.x1 + 2; walk_object()), widened by one on each side.
         inside_.resize(std::max(inside_.size(), acc.words));
-        for (std::size_t j = 0; j < acc.words; ++j) inside_[j] = word_mask(kw + j, r.x0, r.x1);
+        near_.resize(std::max(near_.size(), acc.words));
+        for (std::size_t j = 0; j < acc.words; ++j) {
+            inside_[j] = word_mask(kw + j, r.x0, r.x1);
+            near_[j] = word_mask(kw + j, r.x0 - 2, r.x0 - 1) | word_mask(kw + j, r.x1 + 1, r.x1 + 3);
+        }
         for (int y = r.y0; y <= r.y1; ++y) {
             const std::size_t row = static_cast<std::size_t>(y - acc.y0);
             double* ac = acc.cov.data() + row * cells;
@@ -392,7 +398,8 @@ void Simulator::render(bool all_rows) {
             // where the row is dirty. A still object's written cells are its written bits; a
             // moving object's are among its marked pixels (all dirty) and the cells right of
             // them, and column 0; those are read and cleared. Cells the walk wrote outside the
-            // object's columns (r.x0 - 1 by rounding) are cleared, not added.
+            // object's columns (by rounding: near_) are cleared, not added; the others outside
+            // them hold 0 (the walk did not write them).
             double b = 0, s = 0;
             if (!moving) {
                 const std::uint64_t* wr = acc.written.data() + row * acc.words;
@@ -417,13 +424,14 @@ void Simulator::render(bool all_rows) {
                 const std::uint64_t dm = d[j] & inside;
                 const std::uint64_t wm = d[j] | (d[j] << 1) | carry;
                 carry = d[j] >> 63;
-                for (std::uint64_t e = wm & ~inside; e != 0; e &= e - 1) {
+                for (std::uint64_t e = wm & near_[j]; e != 0; e &= e - 1) {
                     const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(e));
                     ac[c] = 0;
                     if (multi) ai[c] = 0;
                 }
                 for (std::uint64_t m = wm & inside; m != 0; m &= m - 1) {
-                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                    const unsigned bit = static_cast<unsigned>(std::countr_zero(m));
+                    const std::size_t c = j * 64 + bit;
                     b += ac[c];
                     ac[c] = 0;
                     if (multi) {
@@ -432,10 +440,11 @@ void Simulator::render(bool all_rows) {
                     }
                     // Composited where dirty and covered, without a branch (the same value as
                     // a branch would store).
-                    const bool comp = (dm & (m & -m)) != 0 && b > kSnap;
+                    const bool comp = ((dm >> bit) & 1u) != 0 && b > kSnap;
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;
-                    const double v = out[c] * (1.0 - bc) + (multi ? s : bc * level);
-                    out[c] = comp ? v : out[c];
+                    const double old = out[c];
+                    const double v = old * (1.0 - bc) + (multi ? s : bc * level);
+                    out[c] = comp ? v : old;
                 }
             }
         }
@@ -649,8 +658,11 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
             return;
         }
         worst = std::max(worst, d / den);
-        // Most pixels do not cross: nothing to do but note the change.
-        if (b > a ? b < ion_[p] : b > ioff_[p]) return;
+        // Most pixels do not cross: nothing to do but note the change. (Both thresholds read
+        // and compared, without a branch on the direction, which is unpredictable.)
+        const bool up = b > a;
+        const bool below_on = b < ion_[p], above_off = b > ioff_[p];
+        if (up ? below_on : above_off) return;
         // A crossing. Where the pixel also changed in the step before, the parabola through
         // its three values tells how far the crossing's time would move if I bends like it;
         // within the tolerance the straight line is kept without a sample. A pixel that
