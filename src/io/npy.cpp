@@ -53,14 +53,20 @@ NpyWriter::NpyWriter(std::string path) : out_(regular_file(std::move(path))) {
 NpyWriter::~NpyWriter() = default;  // without close(), out_ removes the unfinished file
 
 void NpyWriter::write(std::span<const Event> events) {
-    for (const Event& e : events) {
-        char* dst = out_.reserve(sizeof(Event));
-        std::memset(dst, 0, sizeof(Event));  // the padding bytes are part of the file
-        std::memcpy(dst, &e.t, 8);
-        std::memcpy(dst + 8, &e.x, 2);
-        std::memcpy(dst + 10, &e.y, 2);
-        dst[12] = static_cast<char>(e.p != 0);
-        out_.commit(sizeof(Event));
+    // Records are reserved a block at a time (a call per event cost more than the copying).
+    constexpr std::size_t kBlock = 4096;
+    for (std::size_t i = 0; i < events.size(); i += kBlock) {
+        const std::size_t n = std::min(kBlock, events.size() - i);
+        char* dst = out_.reserve(n * sizeof(Event));
+        std::memset(dst, 0, n * sizeof(Event));  // the padding bytes are part of the file
+        for (const Event& e : events.subspan(i, n)) {
+            std::memcpy(dst, &e.t, 8);
+            std::memcpy(dst + 8, &e.x, 2);
+            std::memcpy(dst + 10, &e.y, 2);
+            dst[12] = static_cast<char>(e.p != 0);
+            dst += sizeof(Event);
+        }
+        out_.commit(n * sizeof(Event));
     }
     count_ += events.size();
 }

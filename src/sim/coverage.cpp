@@ -16,16 +16,23 @@ struct DenseSink {
     double* acc;
     double* acc2;
     std::size_t stride;
-    void add(int r, int k, double v, double v2) noexcept {
-        const std::size_t i = static_cast<std::size_t>(r) * stride + static_cast<std::size_t>(k);
-        acc[i] += v;
-        if constexpr (Dual) acc2[i] += v2;
+    struct Row {
+        double* acc;
+        double* acc2;
+        void add(int k, double v, double v2) noexcept {
+            acc[k] += v;
+            if constexpr (Dual) acc2[k] += v2;
+        }
+        void add_pair(int k, double v0, double v1, double w0, double w1) noexcept {
+            add(k, v0, w0);
+            add(k + 1, v1, w1);
+        }
+    };
+    Row row(int r) const noexcept {
+        const std::size_t i = static_cast<std::size_t>(r) * stride;
+        return {acc + i, Dual ? acc2 + i : nullptr};
     }
-    void add_pair(int r, int k, double v0, double v1, double w0, double w1) noexcept {
-        add(r, k, v0, w0);
-        add(r, k + 1, v1, w1);
-    }
-    void span(int, double, double) noexcept {}
+    void rows(int, int) noexcept {}
     void flat(double, double, double) noexcept {}
 };
 

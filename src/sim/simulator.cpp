@@ -72,7 +72,7 @@ Simulator::Simulator(Scene scene)
       end_(static_cast<double>(scene_.duration_us())),
       noise_rng_(scene_.seed, kSaltNoise) {
     const std::size_t n = static_cast<std::size_t>(scene_.sensor.pixels());
-    // Pixels, accumulator cells and bitmap bits are indexed with 32 bits (Term, changed_).
+    // Pixels, accumulator cells and bitmap bits are indexed with 32 bits.
     if (std::max(stride_, words_ * 64) * static_cast<std::size_t>(h_) > UINT32_MAX)
         throw std::length_error("simulate: a " + std::to_string(w_) + "x" + std::to_string(h_) +
                                 " sensor is too large for the simulator (at most about 4.29e9 pixels)");
@@ -222,38 +222,48 @@ struct Simulator::AccSink {
     std::size_t mwords;
     int w, h;
 
-    void add_pair(int r, int k, double v0, double v1, double w0, double w1) {
-        const std::size_t row = static_cast<std::size_t>(r - y0);
-        const std::size_t c = static_cast<std::size_t>(k - x0);
-        const std::size_t cell = row * cells + c;
-        cov[cell] += v0;
-        cov[cell + 1] += v1;
-        if constexpr (Dual) {
-            val[cell] += w0;
-            val[cell + 1] += w1;
+    // Row r's part: pointers to its first window cell, written bits and marks, so that the
+    // walk's pieces in the row (contiguous columns) index from registers.
+    struct Row {
+        double* cov;
+        double* val;
+        std::uint64_t* written;
+        std::uint64_t* marks;
+        int x0;
+        void add_pair(int k, double v0, double v1, double w0, double w1) noexcept {
+            const std::size_t c = static_cast<std::size_t>(k - x0);
+            cov[c] += v0;
+            cov[c + 1] += v1;
+            if constexpr (Dual) {
+                val[c] += w0;
+                val[c + 1] += w1;
+            }
+            if constexpr (Moving) {
+                marks[static_cast<unsigned>(k) >> 6] |= std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
+            } else {
+                std::uint64_t* wr = written + (c >> 6);
+                const unsigned bit = static_cast<unsigned>(c) & 63u;
+                wr[0] |= std::uint64_t{3} << bit;  // cells c and c + 1 (the latter in the next word when bit is 63)
+                if (bit == 63) wr[1] |= 1;
+            }
         }
-        if constexpr (Moving) {
-            marks[static_cast<std::size_t>(r) * mwords + (static_cast<unsigned>(k) >> 6)] |=
-                std::uint64_t{1} << (static_cast<unsigned>(k) & 63u);
-        } else {
-            std::uint64_t* wr = written + row * words + (c >> 6);
-            const unsigned bit = static_cast<unsigned>(c) & 63u;
-            wr[0] |= std::uint64_t{3} << bit;  // cells c and c + 1 (the latter in the next word when bit is 63)
-            if (bit == 63) wr[1] |= 1;
+        // A single addition (at column 0, for the part of an edge left of the sensor, which
+        // covers no pixel of its own).
+        void add(int k, double v, double w2) noexcept {
+            const std::size_t c = static_cast<std::size_t>(k - x0);
+            cov[c] += v;
+            if constexpr (Dual) val[c] += w2;
+            if constexpr (!Moving) written[c >> 6] |= std::uint64_t{1} << (c & 63u);
         }
+    };
+    Row row(int r) const noexcept {
+        const std::size_t wrow = static_cast<std::size_t>(r - y0);
+        return {cov + wrow * cells, Dual ? val + wrow * cells : nullptr, Moving ? nullptr : written + wrow * words,
+                Moving ? marks + static_cast<std::size_t>(r) * mwords : nullptr, x0};
     }
-    // A single addition (at column 0, for the part of an edge left of the sensor, which
-    // covers no pixel of its own).
-    void add(int r, int k, double v, double w2) {
-        const std::size_t row = static_cast<std::size_t>(r - y0);
-        const std::size_t c = static_cast<std::size_t>(k - x0);
-        cov[row * cells + c] += v;
-        if constexpr (Dual) val[row * cells + c] += w2;
-        if constexpr (!Moving) written[row * words + (c >> 6)] |= std::uint64_t{1} << (c & 63u);
-    }
-    void span(int r, double, double) noexcept {
-        if (r < my0) my0 = r;
-        if (r > my1) my1 = r;
+    void rows(int r0, int r1) noexcept {
+        if (r0 < my0) my0 = r0;
+        if (r1 > my1) my1 = r1;
     }
     void flat(double y, double xl, double xr) noexcept {
         if (!Moving || y + kMarkMargin < 0 || y - kMarkMargin >= h) return;
@@ -263,10 +273,8 @@ struct Simulator::AccSink {
         const int hi = hi_x >= w - 1 ? w - 1 : static_cast<int>(hi_x);
         const int r0 = std::max(0, static_cast<int>(std::floor(y - kMarkMargin)));
         const int r1 = std::min(h - 1, static_cast<int>(std::floor(y + kMarkMargin)));
-        for (int r = r0; r <= r1; ++r) {
-            set_range(marks + static_cast<std::size_t>(r) * mwords, lo, hi);
-            span(r, xl, xr);
-        }
+        for (int r = r0; r <= r1; ++r) set_range(marks + static_cast<std::size_t>(r) * mwords, lo, hi);
+        if (r0 <= r1) rows(r0, r1);
     }
 };
 
@@ -317,8 +325,9 @@ void Simulator::render(bool all_rows) {
         dirty_y1_ = h_ - 1;
     } else {
         // The pixels the moving edges pass through now (cur_marks_, marked by their edge
-        // walks) and at time_us() (prev_marks_, kept from the step that reached it).
-        for (int y = cur_y0_; y <= cur_y1_; ++y) std::fill_n(row_bits(cur_marks_, y), words_, 0);
+        // walks) and at time_us() (prev_marks_, kept from the step that reached it). cur_marks_
+        // is all zero here: the union below clears prev_marks_ as it reads it, and the two
+        // swap after the step.
         cur_y0_ = h_;
         cur_y1_ = -1;
         for (std::size_t o = 0; o < rects_.size(); ++o)
@@ -332,8 +341,11 @@ void Simulator::render(bool all_rows) {
         std::uint64_t* d = row_bits(dirty_, y);
         if (!all_rows) {
             const std::uint64_t* c = row_bits(cur_marks_, y);
-            const std::uint64_t* p = row_bits(prev_marks_, y);
-            for (std::size_t k = 0; k < words_; ++k) d[k] = c[k] | p[k];
+            std::uint64_t* p = row_bits(prev_marks_, y);
+            for (std::size_t k = 0; k < words_; ++k) {
+                d[k] = c[k] | p[k];
+                p[k] = 0;  // read for the last time (cleared here rather than in a pass of its own)
+            }
         }
         const std::size_t base = static_cast<std::size_t>(y) * w;
         for (std::size_t k = 0; k < words_; ++k)
@@ -365,9 +377,15 @@ void Simulator::render(bool all_rows) {
         ObjectAcc& acc = acc_[o];
         const std::size_t cells = acc.words * 64;
         const std::size_t kw = static_cast<std::size_t>(acc.x0) / 64;  // the window's first sensor word
-        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row).
+        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row),
+        // and the columns just outside them that its walk may write by rounding (r.x0 - 1 and
+        // r.x1 + 1, r.x1 + 2; walk_object()), widened by one on each side.
         inside_.resize(std::max(inside_.size(), acc.words));
-        for (std::size_t j = 0; j < acc.words; ++j) inside_[j] = word_mask(kw + j, r.x0, r.x1);
+        near_.resize(std::max(near_.size(), acc.words));
+        for (std::size_t j = 0; j < acc.words; ++j) {
+            inside_[j] = word_mask(kw + j, r.x0, r.x1);
+            near_[j] = word_mask(kw + j, r.x0 - 2, r.x0 - 1) | word_mask(kw + j, r.x1 + 1, r.x1 + 3);
+        }
         for (int y = r.y0; y <= r.y1; ++y) {
             const std::size_t row = static_cast<std::size_t>(y - acc.y0);
             double* ac = acc.cov.data() + row * cells;
@@ -380,7 +398,8 @@ void Simulator::render(bool all_rows) {
             // where the row is dirty. A still object's written cells are its written bits; a
             // moving object's are among its marked pixels (all dirty) and the cells right of
             // them, and column 0; those are read and cleared. Cells the walk wrote outside the
-            // object's columns (r.x0 - 1 by rounding) are cleared, not added.
+            // object's columns (by rounding: near_) are cleared, not added; the others outside
+            // them hold 0 (the walk did not write them).
             double b = 0, s = 0;
             if (!moving) {
                 const std::uint64_t* wr = acc.written.data() + row * acc.words;
@@ -405,13 +424,14 @@ void Simulator::render(bool all_rows) {
                 const std::uint64_t dm = d[j] & inside;
                 const std::uint64_t wm = d[j] | (d[j] << 1) | carry;
                 carry = d[j] >> 63;
-                for (std::uint64_t e = wm & ~inside; e != 0; e &= e - 1) {
+                for (std::uint64_t e = wm & near_[j]; e != 0; e &= e - 1) {
                     const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(e));
                     ac[c] = 0;
                     if (multi) ai[c] = 0;
                 }
                 for (std::uint64_t m = wm & inside; m != 0; m &= m - 1) {
-                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                    const unsigned bit = static_cast<unsigned>(std::countr_zero(m));
+                    const std::size_t c = j * 64 + bit;
                     b += ac[c];
                     ac[c] = 0;
                     if (multi) {
@@ -420,30 +440,15 @@ void Simulator::render(bool all_rows) {
                     }
                     // Composited where dirty and covered, without a branch (the same value as
                     // a branch would store).
-                    const bool comp = (dm & (m & -m)) != 0 && b > kSnap;
+                    const bool comp = ((dm >> bit) & 1u) != 0 && b > kSnap;
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;
-                    const double v = out[c] * (1.0 - bc) + (multi ? s : bc * level);
-                    out[c] = comp ? v : out[c];
+                    const double old = out[c];
+                    const double v = old * (1.0 - bc) + (multi ? s : bc * level);
+                    out[c] = comp ? v : old;
                 }
             }
         }
     }
-    // The dirty pixels that changed.
-    changed_.resize(cur_.size());  // room for every pixel (only the first nc are kept)
-    std::uint32_t* ch = changed_.data();
-    std::size_t nc = 0;
-    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
-        const std::uint64_t* d = row_bits(dirty_, y);
-        const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (std::size_t k = 0; k < words_; ++k)
-            for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
-                const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                // Without branches: every dirty pixel's index is written, kept when it changed.
-                ch[nc] = static_cast<std::uint32_t>(i);
-                nc += cur_[i] != next_[i] ? 1 : 0;
-            }
-    }
-    changed_n_ = nc;
 }
 
 double Simulator::max_displacement() const noexcept {
@@ -634,10 +639,14 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     }
     double worst = 0;
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
-    for (const std::uint32_t pix : std::span<const std::uint32_t>(changed_.data(), changed_n_)) {
-        const std::size_t p = pix;
-        if (ready_[p] == 0) ready_pixel(p);
+    // The dirty pixels (render()) in row-major order; those whose value changed go on. Read
+    // from the bitmap here rather than listed by render() in a pass of their own.
+    std::size_t changed = 0;
+    auto pixel = [&](std::size_t p) {
         const double a = cur_[p], b = next_[p];
+        if (a == b) return;
+        ++changed;
+        if (ready_[p] == 0) ready_pixel(p);
         cur_[p] = b;
         const double d = std::abs(a - b), den = kLogEps + std::min(a, b);
         const bool had_history = hist_step_[p] == step_index;
@@ -646,11 +655,14 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         hist_step_[p] = step_index + 1;
         if (d > limit_ * den) {
             refine(p, 0, kKeyEnd, a, b, false, ev);
-            continue;
+            return;
         }
         worst = std::max(worst, d / den);
-        // Most pixels do not cross: nothing to do but note the change.
-        if (b > a ? b < ion_[p] : b > ioff_[p]) continue;
+        // Most pixels do not cross: nothing to do but note the change. (Both thresholds read
+        // and compared, without a branch on the direction, which is unpredictable.)
+        const bool up = b > a;
+        const bool below_on = b < ion_[p], above_off = b > ioff_[p];
+        if (up ? below_on : above_off) return;
         // A crossing. Where the pixel also changed in the step before, the parabola through
         // its three values tells how far the crossing's time would move if I bends like it;
         // within the tolerance the straight line is kept without a sample. A pixel that
@@ -665,11 +677,20 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
             const double shift = std::abs(c * u * (u - 1.0) / (b - a)) * step_len_;
             if (shift <= crossing_tol_us_) {
                 cross(p, t0, t1, a, b, ev);
-                continue;
+                return;
             }
         }
         refine(p, 0, kKeyEnd, a, b, false, ev);
+    };
+    const std::size_t w = static_cast<std::size_t>(w_);
+    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
+        const std::uint64_t* dm = row_bits(dirty_, y);
+        const std::size_t base = static_cast<std::size_t>(y) * w;
+        for (std::size_t k = 0; k < words_; ++k)
+            for (std::uint64_t m = dm[k]; m != 0; m &= m - 1)
+                pixel(base + k * 64 + static_cast<std::size_t>(std::countr_zero(m)));
     }
+    changed_n_ = changed;
     stats_.max_step_change = std::max(stats_.max_step_change, worst / scene_.camera.contrast);
 }
 

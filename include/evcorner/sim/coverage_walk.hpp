@@ -6,14 +6,17 @@
 // Each edge is cut at the row and column lines into pieces lying in one cell; a piece with
 // signed height h (the edge's y-extent in the cell, positive upwards) and mean x xm in cell
 // column k adds h (k + 1 - xm) to its own cell and h (xm - k) to the next one. The sink gets:
-//   sink.add(r, k, v, v2)   add v at row r, column k (and v2 into the second array when Dual)
-//   sink.add_pair(r, k, v0, v1, w0, w1)   add v0 at column k, then v1 at column k + 1 (and
+//   sink.row(r)             a row sink for row r (made once per row an edge crosses; it
+//                           keeps the row's pointers in registers), on which:
+//     row.add(k, v, v2)     add v at column k (and v2 into the second array when Dual)
+//     row.add_pair(k, v0, v1, w0, w1)   add v0 at column k, then v1 at column k + 1 (and
 //                           w0, w1 into the second array when Dual)
-//   sink.span(r, xl, xr)    a slanted edge crosses row r between x = xl and x = xr
+//   sink.rows(r0, r1)       a slanted edge crosses rows r0 .. r1 (called once per edge, before
+//                           its rows' additions; not called when it crosses none)
 //   sink.flat(y, xl, xr)    a horizontal edge at y from x = xl to x = xr (it adds nothing)
 // Parts left of x = 0 add to column 0, parts right of x = width and outside rows
-// [0, height) add nothing; span() is called for every row in [0, height) an edge crosses,
-// wherever it lies in x.
+// [0, height) add nothing; rows() gets every row in [0, height) an edge crosses, wherever it
+// lies in x.
 
 #include <algorithm>
 #include <cmath>
@@ -32,6 +35,9 @@ void walk_coverage_edge(double x0, double y0, double x1, double y1, double sign,
     const double dxdy = (x1 - x0) / (y1 - y0);
     const int r0 = std::max(0, static_cast<int>(std::floor(y0)));
     const int r1 = std::min(height - 1, static_cast<int>(std::ceil(y1)) - 1);
+    // Every row r0 .. r1 is crossed: r0 <= y0 < r0 + 1 (or r0 = 0 and y0 < 0 < y1) and
+    // r1 < y1, so each row's part [ya, yb] below has yb > ya.
+    if (r0 <= r1) sink.rows(r0, r1);
     for (int r = r0; r <= r1; ++r) {
         const double ya = std::max(y0, static_cast<double>(r));
         const double yb = std::min(y1, static_cast<double>(r + 1));
@@ -40,36 +46,39 @@ void walk_coverage_edge(double x0, double y0, double x1, double y1, double sign,
         const double h2 = Dual ? sign2 * (yb - ya) : 0.0;
         const double xa = x0 + (ya - y0) * dxdy, xb = x0 + (yb - y0) * dxdy;
         const double xl = std::min(xa, xb), xr = std::max(xa, xb);
-        sink.span(r, xl, xr);
+        auto row = sink.row(r);
         if (xr <= 0) {  // wholly left of the sensor: covers every pixel of the row to its right
-            sink.add(r, 0, h, h2);
+            row.add(0, h, h2);
             continue;
         }
         if (xl >= width) continue;
         if (xr == xl) {
             const int k = static_cast<int>(xl);  // xl > 0: truncation is floor
-            sink.add_pair(r, k, h * (k + 1 - xl), h * (xl - k), Dual ? h2 * (k + 1 - xl) : 0.0,
-                          Dual ? h2 * (xl - k) : 0.0);
+            row.add_pair(k, h * (k + 1 - xl), h * (xl - k), Dual ? h2 * (k + 1 - xl) : 0.0, Dual ? h2 * (xl - k) : 0.0);
             continue;
         }
         const double per_x = h / (xr - xl);
         const double per_x2 = Dual ? h2 / (xr - xl) : 0.0;
         double lo = xl;
         if (lo < 0) {
-            sink.add(r, 0, per_x * (0 - lo), Dual ? per_x2 * (0 - lo) : 0.0);
+            row.add(0, per_x * (0 - lo), Dual ? per_x2 * (0 - lo) : 0.0);
             lo = 0;
         }
         const double hi_end = std::min(xr, static_cast<double>(width));
         int k = static_cast<int>(lo);  // lo >= 0: truncation is floor
+        // The column as a double too (k and k + 1 are exact in a double, so every value is
+        // the one int-to-double conversions would give; this saves two conversions a piece).
+        double kd = k;
         while (lo < hi_end) {
-            const double hi = std::min(hi_end, static_cast<double>(k + 1));
+            const double kd1 = kd + 1.0;
+            const double hi = std::min(hi_end, kd1);
             const double hp = per_x * (hi - lo);
             const double xm = 0.5 * (lo + hi);
             const double hp2 = Dual ? per_x2 * (hi - lo) : 0.0;
-            sink.add_pair(r, k, hp * (k + 1 - xm), hp * (xm - k), Dual ? hp2 * (k + 1 - xm) : 0.0,
-                          Dual ? hp2 * (xm - k) : 0.0);
+            row.add_pair(k, hp * (kd1 - xm), hp * (xm - kd), Dual ? hp2 * (kd1 - xm) : 0.0, Dual ? hp2 * (xm - kd) : 0.0);
             lo = hi;
             ++k;
+            kd = kd1;
         }
     }
 }

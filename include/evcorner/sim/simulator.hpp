@@ -89,7 +89,7 @@ private:
         [[nodiscard]] bool empty() const noexcept { return x1 < x0 || y1 < y0; }
     };
     void place_objects(double t_us);  // fills polys_ and rects_ for time t
-    void render(bool all_rows);       // renders into next_ over the dirty pixels; lists those that changed
+    void render(bool all_rows);       // renders into next_ over the dirty pixels (dirty_)
     // An object's own accumulators: its edge walk's additions (coverage_walk.hpp) into a
     // window of rows y0 .. y1 and of words columns from x0 (a multiple of 64) that holds every
     // cell the walk can write at the time being rendered. cov gets the coverage additions, val
@@ -165,8 +165,8 @@ private:
     std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, zero_row_;
     int cur_y0_ = 0, cur_y1_ = -1, prev_y0_ = 0, prev_y1_ = -1, dirty_y0_ = 0, dirty_y1_ = -1;
     std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
-    std::vector<std::uint32_t> changed_;  // its first changed_n_: the dirty pixels whose next_ differs from cur_
-    std::size_t changed_n_ = 0;
+    std::vector<std::uint64_t> near_;    // render(): the columns just outside them its walk may write
+    std::size_t changed_n_ = 0;  // the dirty pixels whose value changed in the last step (emit_crossings)
     // Per-pixel sampling: each object's first piece in a numbering of every object's pieces in
     // order (object_first_piece_, plus the end), the pixels each object can cover within the step (step_rect_), the placements of the
     // current step (a pool reused from step to step) and their index by object and key; the
