@@ -31,7 +31,7 @@ std::string lower_trim(std::string_view s) {
 CsvReader::CsvReader(InputFile file, ReaderOptions options)
     : lines_(std::move(file)), options_(std::move(options)) {
     format_ = "csv";
-    if (const auto c = lines_.file().compression()) format_ += "+" + std::string(compression_name(*c));
+    if (const auto c = lines_.file().compression()) format_.append("+").append(compression_name(*c));  // not "+" + string: GCC 12 -Wrestrict false positive
     sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
     const std::string& u = options_.csv_time_unit;
     if (u == "us" || u.empty()) time_digits_ = 0;

@@ -87,7 +87,7 @@ Parsed parse_line(const char* p, const char* end) {
 TextReader::TextReader(InputFile file, ReaderOptions options)
     : lines_(std::move(file)), options_(std::move(options)) {
     format_ = "ecd-text";
-    if (const auto c = lines_.file().compression()) format_ += "+" + std::string(compression_name(*c));
+    if (const auto c = lines_.file().compression()) format_.append("+").append(compression_name(*c));  // not "+" + string: GCC 12 -Wrestrict false positive
 }
 
 std::size_t TextReader::read(std::span<Event> out) {
