@@ -445,5 +445,25 @@ TEST_F(CliOutputs, Hdf5FailuresSayWhyWithoutHdf5sOwnStack) {
     }
 }
 
+// libhdf5 and libmatio (with libcurl, GnuTLS, Kerberos, ... behind them) are opened when an
+// HDF5 or .mat file is used, not at every start (io/dynamic_library.hpp).
+TEST_F(CliOutputs, Hdf5AndMatioAreLoadedOnlyWhenUsed) {
+    // LD_TRACE_LOADED_OBJECTS=1: the dynamic loader lists what it loads at start, and stops
+    // (what ldd does).
+    const std::string cmd = "LD_TRACE_LOADED_OBJECTS=1 '" EVCORNER_CLI "' >'" + (dir_ / "libs.txt").string() + "' 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string libs = slurp(dir_ / "libs.txt");
+    ASSERT_NE(libs.find("libc.so"), std::string::npos) << libs;  // the listing worked
+    EXPECT_EQ(libs.find("libhdf5"), std::string::npos) << libs;
+    EXPECT_EQ(libs.find("libmatio"), std::string::npos) << libs;
+    EXPECT_EQ(libs.find("libcurl"), std::string::npos) << libs;
+    // ... and HDF5 still works when asked: a round trip through an .h5 file.
+    Result r = run("convert " + sample() + " x.h5");
+    ASSERT_EQ(r.status, 0) << r.err;
+    r = run("convert x.h5 back.txt");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(count_lines(slurp(dir_ / "back.txt")), count_lines(slurp(sample_)));
+}
+
 }  // namespace
 }  // namespace evcorner

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/dynamic_library.hpp"
 #include "evcorner/io/event_writer.hpp"
 #include "evcorner/io/hdf5_events.hpp"
 #include "evcorner/io/open.hpp"
@@ -228,6 +229,27 @@ TEST(Hdf5Bad, CutFileIsAnErrorNotACrash) {
         failed = true;
     }
     EXPECT_TRUE(failed);
+}
+
+// The loader behind the lazily opened libhdf5 and libmatio: a library that does not load, or
+// lacks a name, is an error that names it (never a null pointer called later).
+TEST(DynamicLibrary, ErrorsNameTheLibraryAndTheSymbol) {
+    try {
+        io::DynamicLibrary lib("libnothing, for a test", {"libevcorner-no-such-library.so.0", "/no/such/path.so"});
+        FAIL() << "loaded " << lib.loaded_name();
+    } catch (const std::runtime_error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("cannot load libnothing, for a test"), std::string::npos) << what;
+        EXPECT_NE(what.find("libevcorner-no-such-library.so.0"), std::string::npos) << what;
+        EXPECT_NE(what.find("/no/such/path.so"), std::string::npos) << what;
+    }
+    const io::DynamicLibrary libm("libm", {"libevcorner-no-such-library.so.0", "libm.so.6"});
+    EXPECT_EQ(libm.loaded_name(), "libm.so.6");
+    double (*fabs_fn)(double) = nullptr;
+    libm.symbol(fabs_fn, "fabs");
+    ASSERT_NE(fabs_fn, nullptr);
+    EXPECT_EQ(fabs_fn(-2.5), 2.5);
+    EXPECT_THROW((void)libm.address("evcorner_no_such_symbol"), std::runtime_error);
 }
 
 }  // namespace

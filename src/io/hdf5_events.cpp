@@ -13,11 +13,86 @@
 #include <utility>
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/dynamic_library.hpp"
 #include "evcorner/io/pending_file.hpp"
 
 namespace evcorner::io {
 
 namespace {
+
+// ---------------------------------------------------------------- libhdf5, opened on first use
+// libhdf5 is not linked: io/dynamic_library.hpp says why, and how the names below shadow
+// <hdf5.h>'s. Every HDF5 function this file calls (also through H5E_BEGIN_TRY / H5E_END_TRY
+// and the H5OPEN in the type macros), and every global behind a macro it uses:
+#define EVCORNER_HDF5_FUNCTIONS(X)                                                                               \
+    X(H5open) X(H5check_version) X(H5dont_atexit) X(H5Eauto_is_v2) X(H5Eget_auto1) X(H5Eset_auto1) X(H5Eget_auto2)                 \
+    X(H5Eset_auto2) X(H5Ewalk2) X(H5Eclear2) X(H5Fis_hdf5) X(H5Fopen) X(H5Fcreate) X(H5Fclose) X(H5Fflush)       \
+    X(H5Fget_vfd_handle) X(H5Gcreate2) X(H5Gclose) X(H5Lexists) X(H5Dopen2) X(H5Dcreate2) X(H5Dclose)            \
+    X(H5Dget_space) X(H5Dget_type) X(H5Dget_create_plist) X(H5Dget_storage_size) X(H5Dget_offset)                \
+    X(H5Dget_chunk_info_by_coord) X(H5Dread) X(H5Dwrite) X(H5Dset_extent) X(H5Aexists) X(H5Aopen)                \
+    X(H5Acreate2) X(H5Aget_space) X(H5Aget_type) X(H5Aread) X(H5Awrite) X(H5Aclose) X(H5Screate)                 \
+    X(H5Screate_simple) X(H5Sget_simple_extent_ndims) X(H5Sget_simple_extent_dims)                              \
+    X(H5Sget_simple_extent_npoints) X(H5Sselect_hyperslab) X(H5Sclose) X(H5Tget_class) X(H5Tget_size)           \
+    X(H5Tget_native_type) X(H5Tclose) X(H5Pcreate) X(H5Pclose) X(H5Pget_nfilters) X(H5Pget_filter2)             \
+    X(H5Pget_layout) X(H5Pget_chunk) X(H5Pset_chunk) X(H5Pset_deflate) X(H5Pset_filter) X(H5Zfilter_avail)
+#define EVCORNER_HDF5_GLOBALS(X)                                                                                 \
+    X(H5T_NATIVE_DOUBLE_g) X(H5T_NATIVE_INT_g) X(H5T_NATIVE_INT32_g) X(H5T_NATIVE_INT64_g)                        \
+    X(H5T_NATIVE_UINT16_g) X(H5T_NATIVE_UINT8_g) X(H5T_STD_I32LE_g) X(H5T_STD_I64LE_g) X(H5T_STD_U16LE_g)        \
+    X(H5T_STD_U8LE_g) X(H5P_CLS_DATASET_CREATE_ID_g)
+
+struct Hdf5Api {
+#define EVCORNER_FIELD(name) decltype(&::name) name = nullptr;
+    EVCORNER_HDF5_FUNCTIONS(EVCORNER_FIELD)
+#undef EVCORNER_FIELD
+#define EVCORNER_FIELD(name) const hid_t* name = nullptr;
+    EVCORNER_HDF5_GLOBALS(EVCORNER_FIELD)
+#undef EVCORNER_FIELD
+
+    /// The table, the library loaded on the first call (thread-safe); throws
+    /// std::runtime_error when it cannot be loaded or lacks a name.
+    static const Hdf5Api& get() {
+        static const Hdf5Api api = [] {
+            static const DynamicLibrary lib("libhdf5, which HDF5 files need (Debian: apt-get install libhdf5-103-1)",
+                                            {EVCORNER_HDF5_SONAME, EVCORNER_HDF5_PATH});
+            Hdf5Api a;
+#define EVCORNER_LOAD(name) lib.symbol(a.name, #name);
+            EVCORNER_HDF5_FUNCTIONS(EVCORNER_LOAD)
+#undef EVCORNER_LOAD
+#define EVCORNER_LOAD(name) a.name = static_cast<const hid_t*>(lib.variable_address(#name));
+            EVCORNER_HDF5_GLOBALS(EVCORNER_LOAD)
+#undef EVCORNER_LOAD
+            // HDF5 prints its error stack to standard error on failure, also from the
+            // library's own clean-up at exit, where no H5E_BEGIN_TRY reaches: switched off
+            // once for the process (evcorner reports every failure itself, with
+            // hdf5_reason()). And that clean-up at exit is not registered (H5dont_atexit,
+            // which must come before HDF5's first call): after a write failure libhdf5 1.10
+            // keeps a file it cannot close, and its clean-up then crashes or prints "infinite
+            // loop closing library". Every file evcorner opens is closed by its reader or
+            // writer; the operating system takes back the rest at exit. H5open() sets the
+            // type globals (the type macros call it too, before reading one).
+            a.H5dont_atexit();
+            a.H5open();
+            a.H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+            return a;
+        }();
+        return api;
+    }
+};
+
+// The shadows: H5Fopen(...) here calls the loaded H5Fopen, H5T_NATIVE_INT reads the loaded
+// H5T_NATIVE_INT_g.
+#define EVCORNER_SHADOW(name) [[maybe_unused]] constexpr auto name = &Forwarder<decltype(&::name)>::call<Hdf5Api, &Hdf5Api::name>;
+EVCORNER_HDF5_FUNCTIONS(EVCORNER_SHADOW)
+#undef EVCORNER_SHADOW
+struct Hdf5Global {
+    const hid_t* Hdf5Api::*field;
+    operator hid_t() const { return *(Hdf5Api::get().*field); }  // NOLINT: converts implicitly, as the global did
+};
+#define EVCORNER_SHADOW(name) [[maybe_unused]] constexpr Hdf5Global name{&Hdf5Api::name};
+EVCORNER_HDF5_GLOBALS(EVCORNER_SHADOW)
+#undef EVCORNER_SHADOW
+#undef EVCORNER_HDF5_FUNCTIONS
+#undef EVCORNER_HDF5_GLOBALS
 
 // An HDF5 identifier closed by the matching H5?close at scope exit.
 class Hid {
@@ -54,20 +129,15 @@ auto quiet(F&& f) {
     return r;
 }
 
-// HDF5 prints its error stack to standard error on failure, also from the library's own
-// clean-up at exit, where no H5E_BEGIN_TRY reaches: switched off once for the process
-// (evcorner reports every failure itself, with hdf5_reason()). And that clean-up at exit
-// is not registered (H5dont_atexit, which must come before HDF5's first call): after a
-// write failure libhdf5 1.10 keeps a file it cannot close, and its clean-up then crashes
-// or prints "infinite loop closing library". Every file evcorner opens is closed by
-// its reader or writer; the operating system takes back the rest at exit.
-void silence_hdf5() {
-    static const bool done = [] {
-        H5dont_atexit();
-        H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-        return true;
-    }();
-    (void)done;
+// Loads libhdf5 (Hdf5Api::get) where it is not loaded yet; its failure is reported as
+// `Error` naming `file`.
+template <class Error>
+void open_hdf5(const std::string& file) {
+    try {
+        (void)Hdf5Api::get();
+    } catch (const std::runtime_error& e) {
+        throw Error(file, e.what());
+    }
 }
 
 // Why the last HDF5 call failed, from its error stack: the operating system's message
@@ -135,7 +205,7 @@ struct Hdf5Reader::Impl {
 
 Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
     : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdin>" : path), options_(std::move(options)) {
-    silence_hdf5();
+    open_hdf5<InputError>(name_);
     if (path == "-") throw InputError(name_, "HDF5 files cannot be read from standard input");
     file_size_ = regular_file_size(path);
     if (!file_size_) throw InputError(name_, "cannot open: not a regular file, or missing");
@@ -406,13 +476,13 @@ struct Hdf5Writer::Impl {
 };
 
 bool Hdf5Writer::filter_available(int id) {
-    silence_hdf5();
+    open_hdf5<OutputError>("HDF5 output");
     return quiet([&] { return H5Zfilter_avail(static_cast<H5Z_filter_t>(id)); }) > 0;
 }
 
 Hdf5Writer::Hdf5Writer(std::string path, Options options)
     : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdout>" : path), options_(options) {
-    silence_hdf5();
+    open_hdf5<OutputError>(name_);
     if (path == "-") throw OutputError(name_, "HDF5 files cannot go to standard output");
     if (options_.chunk_events == 0) options_.chunk_events = std::size_t{1} << 14;
     // HDF5 writes a temporary file in the target's folder (pending_file.hpp), renamed by close().

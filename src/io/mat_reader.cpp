@@ -10,17 +10,58 @@
 #include <mutex>
 
 #include "evcorner/error.hpp"
+#include "evcorner/io/dynamic_library.hpp"
 #include "evcorner/io/line_source.hpp"
 
 namespace evcorner::io {
 
 namespace {
 
+// ---------------------------------------------------------------- libmatio, opened on first use
+// libmatio is not linked: io/dynamic_library.hpp says why, and how the names below shadow
+// <matio.h>'s. Every matio function this file calls:
+#define EVCORNER_MATIO_FUNCTIONS(X)                                                                              \
+    X(Mat_LogInitFunc) X(Mat_Open) X(Mat_Close) X(Mat_VarReadInfo) X(Mat_VarReadNextInfo) X(Mat_VarRead)          \
+    X(Mat_VarFree) X(Mat_SizeOfClass)
+
+struct MatioApi {
+#define EVCORNER_FIELD(name) decltype(&::name) name = nullptr;
+    EVCORNER_MATIO_FUNCTIONS(EVCORNER_FIELD)
+#undef EVCORNER_FIELD
+
+    /// The table, the library loaded on the first call (thread-safe); throws
+    /// std::runtime_error when it cannot be loaded or lacks a name.
+    static const MatioApi& get() {
+        static const MatioApi api = [] {
+            static const DynamicLibrary lib("libmatio, which .mat files need (Debian: apt-get install libmatio11)",
+                                            {EVCORNER_MATIO_SONAME, EVCORNER_MATIO_PATH});
+            MatioApi a;
+#define EVCORNER_LOAD(name) lib.symbol(a.name, #name);
+            EVCORNER_MATIO_FUNCTIONS(EVCORNER_LOAD)
+#undef EVCORNER_LOAD
+            return a;
+        }();
+        return api;
+    }
+};
+
+// The shadows: Mat_Open(...) here calls the loaded Mat_Open.
+#define EVCORNER_SHADOW(name) [[maybe_unused]] constexpr auto name = &Forwarder<decltype(&::name)>::call<MatioApi, &MatioApi::name>;
+EVCORNER_MATIO_FUNCTIONS(EVCORNER_SHADOW)
+#undef EVCORNER_SHADOW
+#undef EVCORNER_MATIO_FUNCTIONS
+
 // libmatio reports through a log function (its default one prints, and aborts on errors):
 // ours keeps the last message for our own error.
 thread_local std::string g_matio_message;
 void matio_log(int /*level*/, char* message) { g_matio_message = message != nullptr ? message : ""; }
-void init_matio_log() {
+// Also loads libmatio; its failure is an InputError naming `file`.
+void init_matio_log(const std::string& file) {
+    try {
+        (void)MatioApi::get();
+    } catch (const std::runtime_error& e) {
+        throw InputError(file, e.what());
+    }
     static std::once_flag once;
     std::call_once(once, [] { Mat_LogInitFunc("evcorner", matio_log); });
 }
@@ -86,7 +127,7 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
                          "a MATLAB .mat file is read by libmatio from a regular file; a pipe or standard input "
                          "cannot be read as .mat (save it to a file first)");
     file_size_ = static_cast<std::uint64_t>(st.st_size);
-    init_matio_log();
+    init_matio_log(name_);
     g_matio_message.clear();
     MatPtr mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
     if (!mat)
