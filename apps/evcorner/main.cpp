@@ -94,14 +94,20 @@ int main(int argc, char** argv) {
         "  evcorner eval data/ecd --report report        # the paper's Tables 1 and 2, figures\n"
         "  evcorner bench events.txt                     # ns/event, max rate, latency on this machine\n"
         "Exit status: 0 on success, 1 on bad input or a failed write, 2 on a usage error.");
-    evcorner::cli::add_detect_command(app);
-    evcorner::cli::add_info_command(app);
-    evcorner::cli::add_convert_command(app);
-    evcorner::cli::add_label_command(app);
-    evcorner::cli::add_eval_command(app);
-    evcorner::cli::add_render_command(app);
-    evcorner::cli::add_bench_command(app);
-    evcorner::cli::add_simulate_command(app);
+    // Only the command the first argument names is built: all eight commands' options
+    // took about 7 M instructions, two thirds of a run's start. With no command named
+    // (--help, --version, nothing, a slip), all of them, for the list and the suggestions.
+    static constexpr struct {
+        const char* name;
+        void (*add)(CLI::App&);
+    } kCommands[] = {{"detect", evcorner::cli::add_detect_command},   {"info", evcorner::cli::add_info_command},
+                     {"convert", evcorner::cli::add_convert_command}, {"label", evcorner::cli::add_label_command},
+                     {"eval", evcorner::cli::add_eval_command},       {"render", evcorner::cli::add_render_command},
+                     {"bench", evcorner::cli::add_bench_command},     {"simulate", evcorner::cli::add_simulate_command}};
+    const auto named = std::find_if(std::begin(kCommands), std::end(kCommands),
+                                    [&](const auto& c) { return argc > 1 && std::strcmp(argv[1], c.name) == 0; });
+    for (const auto& c : kCommands)
+        if (named == std::end(kCommands) || &c == named) c.add(app);
     // The command list shows each command's first line; the rest of its description
     // heads its own --help, before the examples.
     for (CLI::App* cmd : app.get_subcommands({})) {
