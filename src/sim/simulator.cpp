@@ -377,31 +377,21 @@ void Simulator::render(bool all_rows) {
         ObjectAcc& acc = acc_[o];
         const std::size_t cells = acc.words * 64;
         const std::size_t kw = static_cast<std::size_t>(acc.x0) / 64;  // the window's first sensor word
-        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row),
-        // and the columns just outside them that its walk may write by rounding (r.x0 - 1 and
-        // r.x1 + 1, r.x1 + 2; walk_object()), widened by one on each side.
+        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row).
         inside_.resize(std::max(inside_.size(), acc.words));
-        near_.resize(std::max(near_.size(), acc.words));
-        for (std::size_t j = 0; j < acc.words; ++j) {
-            inside_[j] = word_mask(kw + j, r.x0, r.x1);
-            near_[j] = word_mask(kw + j, r.x0 - 2, r.x0 - 1) | word_mask(kw + j, r.x1 + 1, r.x1 + 3);
-        }
-        for (int y = r.y0; y <= r.y1; ++y) {
-            const std::size_t row = static_cast<std::size_t>(y - acc.y0);
-            double* ac = acc.cov.data() + row * cells;
-            double* ai = multi ? acc.val.data() + row * cells : nullptr;
-            double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
-            const bool in_dirty = y >= dirty_y0_ && y <= dirty_y1_;
-            const std::uint64_t* d = in_dirty ? row_bits(dirty_, y) + kw : zero_row_.data();
-            // The running sums over the window's cells, in column order: adding 0 leaves a
-            // sum as it is, so only the cells the walk may have written are added; composited
-            // where the row is dirty. A still object's written cells are its written bits; a
-            // moving object's are among its marked pixels (all dirty) and the cells right of
-            // them, and column 0; those are read and cleared. Cells the walk wrote outside the
-            // object's columns (by rounding: near_) are cleared, not added; the others outside
-            // them hold 0 (the walk did not write them).
-            double b = 0, s = 0;
-            if (!moving) {
+        for (std::size_t j = 0; j < acc.words; ++j) inside_[j] = word_mask(kw + j, r.x0, r.x1);
+        if (!moving) {
+            for (int y = r.y0; y <= r.y1; ++y) {
+                const std::size_t row = static_cast<std::size_t>(y - acc.y0);
+                const double* ac = acc.cov.data() + row * cells;
+                const double* ai = multi ? acc.val.data() + row * cells : nullptr;
+                double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
+                const bool in_dirty = y >= dirty_y0_ && y <= dirty_y1_;
+                const std::uint64_t* d = in_dirty ? row_bits(dirty_, y) + kw : zero_row_.data();
+                // The running sums over the window's cells, in column order: adding 0 leaves a
+                // sum as it is, so only the cells the walk wrote (its written bits) are added;
+                // composited where the row is dirty.
+                double b = 0, s = 0;
                 const std::uint64_t* wr = acc.written.data() + row * acc.words;
                 for (std::size_t j = 0; j < acc.words; ++j) {
                     const std::uint64_t inside = inside_[j];
@@ -415,38 +405,66 @@ void Simulator::render(bool all_rows) {
                         out[c] = out[c] * (1.0 - bc) + (multi ? s : bc * level);
                     }
                 }
-                continue;
             }
-            std::uint64_t carry = kw > 0 && in_dirty ? d[-1] >> 63 : 0;  // the cell right of a dirty one
-            if (acc.x0 == 0) carry |= 1;                                  // column 0
-            for (std::size_t j = 0; j < acc.words; ++j) {
-                const std::uint64_t inside = inside_[j];
-                const std::uint64_t dm = d[j] & inside;
-                const std::uint64_t wm = d[j] | (d[j] << 1) | carry;
-                carry = d[j] >> 63;
-                for (std::uint64_t e = wm & near_[j]; e != 0; e &= e - 1) {
-                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(e));
-                    ac[c] = 0;
-                    if (multi) ai[c] = 0;
-                }
-                for (std::uint64_t m = wm & inside; m != 0; m &= m - 1) {
-                    const unsigned bit = static_cast<unsigned>(std::countr_zero(m));
-                    const std::size_t c = j * 64 + bit;
+            continue;
+        }
+        // A moving object: the cells its walk wrote are its marked pixels (all dirty), the
+        // cell right of each, and column 0 (then r.x0 is 0), all within r.x0 - 2 .. r.x1 + 3.
+        // So the running sum at a dirty pixel c of the object's columns is that of the cells
+        // before it plus ac[c]: the sum is carried from dirty pixel to dirty pixel, adding at
+        // each its own cell and, after compositing it, the cell right of it, each read and
+        // cleared (a cell added twice holds 0 the second time; adding 0 leaves a sum as it
+        // is, so the nonzero cells are added in column order, as a dense running sum would).
+        // The first column's cell starts the sum (the cell right of a dirty r.x0 - 1, or
+        // column 0). The cells just outside the object's columns that the walk may write by
+        // rounding (r.x0 - 2, r.x0 - 1; r.x1 + 1 .. r.x1 + 3) are cleared, not added (the one
+        // right of r.x1 is added after the last compositing: harmless).
+        std::size_t near_cells[5];
+        std::size_t near_n = 0;
+        for (const int col : {r.x0 - 2, r.x0 - 1, r.x1 + 1, r.x1 + 2, r.x1 + 3})
+            if (col >= acc.x0 && col < acc.x0 + static_cast<int>(cells))
+                near_cells[near_n++] = static_cast<std::size_t>(col - acc.x0);
+        const std::size_t first = static_cast<std::size_t>(r.x0 - acc.x0);
+        const int ry0 = std::max(r.y0, dirty_y0_), ry1 = std::min(r.y1, dirty_y1_);  // walked rows are dirty rows
+        for (int y = ry0; y <= ry1; ++y) {
+            const std::size_t row = static_cast<std::size_t>(y - acc.y0);
+            double* ac = acc.cov.data() + row * cells;
+            double* ai = multi ? acc.val.data() + row * cells : nullptr;
+            double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
+            const std::uint64_t* d = row_bits(dirty_, y) + kw;
+            for (std::size_t i = 0; i < near_n; ++i) {
+                ac[near_cells[i]] = 0;
+                if (multi) ai[near_cells[i]] = 0;
+            }
+            double b = 0, s = 0;
+            b += ac[first];
+            ac[first] = 0;
+            if (multi) {
+                s += ai[first];
+                ai[first] = 0;
+            }
+            for (std::size_t j = 0; j < acc.words; ++j)
+                for (std::uint64_t m = d[j] & inside_[j]; m != 0; m &= m - 1) {
+                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
                     b += ac[c];
                     ac[c] = 0;
                     if (multi) {
                         s += ai[c];
                         ai[c] = 0;
                     }
-                    // Composited where dirty and covered, without a branch (the same value as
-                    // a branch would store).
-                    const bool comp = ((dm >> bit) & 1u) != 0 && b > kSnap;
+                    // Composited where covered, without a branch (the same value as a branch
+                    // would store).
                     const double bc = b >= 1.0 - kSnap ? 1.0 : b;
                     const double old = out[c];
                     const double v = old * (1.0 - bc) + (multi ? s : bc * level);
-                    out[c] = comp ? v : old;
+                    out[c] = b > kSnap ? v : old;
+                    b += ac[c + 1];
+                    ac[c + 1] = 0;
+                    if (multi) {
+                        s += ai[c + 1];
+                        ai[c + 1] = 0;
+                    }
                 }
-            }
         }
     }
 }
