@@ -84,6 +84,7 @@ Simulator::Simulator(Scene scene)
     prev_marks_.assign(bitmap_words, 0);
     dirty_.assign(bitmap_words, 0);
     zero_row_.assign(words_, 0);
+    dirty_list_.resize(n);
     polys_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) polys_[o].resize(scene_.objects[o].pieces.size());
     rects_.resize(scene_.objects.size());
@@ -335,25 +336,28 @@ void Simulator::render(bool all_rows) {
         dirty_y0_ = std::min(cur_y0_, prev_y0_);
         dirty_y1_ = std::max(cur_y1_, prev_y1_);
     }
-    // The dirty pixels start from the background.
+    // The dirty pixels start from the background, and are listed in row-major order
+    // (emit_crossings() reads the list).
     const std::size_t w = static_cast<std::size_t>(w_);
+    std::uint32_t* listed = dirty_list_.data();
     for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
         std::uint64_t* d = row_bits(dirty_, y);
-        if (!all_rows) {
-            const std::uint64_t* c = row_bits(cur_marks_, y);
-            std::uint64_t* p = row_bits(prev_marks_, y);
-            for (std::size_t k = 0; k < words_; ++k) {
-                d[k] = c[k] | p[k];
-                p[k] = 0;  // read for the last time (cleared here rather than in a pass of its own)
-            }
-        }
+        // (Every row: the dirty bits kept, with zero_row_ for the marks to clear; it stays zero.)
+        const std::uint64_t* c = row_bits(all_rows ? dirty_ : cur_marks_, y);
+        std::uint64_t* p = all_rows ? zero_row_.data() : row_bits(prev_marks_, y);
         const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (std::size_t k = 0; k < words_; ++k)
-            for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
+        for (std::size_t k = 0; k < words_; ++k) {
+            const std::uint64_t dk = c[k] | p[k];
+            d[k] = dk;
+            p[k] = 0;  // read for the last time (cleared here rather than in a pass of its own)
+            for (std::uint64_t m = dk; m != 0; m &= m - 1) {
                 const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
                 next_[i] = bg_[i];
+                *listed++ = static_cast<std::uint32_t>(i);
             }
+        }
     }
+    dirty_n_ = static_cast<std::size_t>(listed - dirty_list_.data());
     // Each object over what lies behind it: I = I (1 - b) + sum_k b_k I_k, b = sum_k b_k, its
     // pieces' coverages (they never overlap, so b is the object's own coverage), evaluated only
     // at the dirty pixels.
@@ -657,8 +661,7 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     }
     double worst = 0;
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
-    // The dirty pixels (render()) in row-major order; those whose value changed go on. Read
-    // from the bitmap here rather than listed by render() in a pass of their own.
+    // The dirty pixels (render()'s list, row-major order); those whose value changed go on.
     std::size_t changed = 0;
     auto pixel = [&](std::size_t p) {
         const double a = cur_[p], b = next_[p];
@@ -676,11 +679,13 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
             return;
         }
         worst = std::max(worst, d / den);
-        // Most pixels do not cross: nothing to do but note the change. (Both thresholds read
-        // and compared, without a branch on the direction, which is unpredictable.)
-        const bool up = b > a;
-        const bool below_on = b < ion_[p], above_off = b > ioff_[p];
-        if (up ? below_on : above_off) return;
+        // Most pixels do not cross: nothing to do but note the change. A ready pixel's value
+        // lies strictly between its thresholds (ioff_ < cur_ < ion_: so they are set, and
+        // cross() leaves them so, each a whole threshold of at least 0.01 C beyond the value
+        // that reached the last level), so a rise cannot reach ioff_ nor a fall ion_: the
+        // pixel crosses exactly when its new value is outside the two, whichever way it
+        // moved. Tested without a branch on the direction, which is unpredictable.
+        if ((b < ion_[p]) & (b > ioff_[p])) return;
         // A crossing. Where the pixel also changed in the step before, the parabola through
         // its three values tells how far the crossing's time would move if I bends like it;
         // within the tolerance the straight line is kept without a sample. A pixel that
@@ -700,14 +705,7 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         }
         refine(p, 0, kKeyEnd, a, b, false, ev);
     };
-    const std::size_t w = static_cast<std::size_t>(w_);
-    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
-        const std::uint64_t* dm = row_bits(dirty_, y);
-        const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (std::size_t k = 0; k < words_; ++k)
-            for (std::uint64_t m = dm[k]; m != 0; m &= m - 1)
-                pixel(base + k * 64 + static_cast<std::size_t>(std::countr_zero(m)));
-    }
+    for (std::size_t i = 0; i < dirty_n_; ++i) pixel(dirty_list_[i]);
     changed_n_ = changed;
     stats_.max_step_change = std::max(stats_.max_step_change, worst / scene_.camera.contrast);
 }
