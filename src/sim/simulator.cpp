@@ -5,6 +5,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <emmintrin.h>  // SSE2 (baseline x86-64): branch-free selects in the compositing
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -52,6 +53,31 @@ inline void set_range(std::uint64_t* row, int lo, int hi) noexcept {
     row[wh] |= mh;
 }
 
+// The number of set bits (without the popcnt instruction, which the baseline x86-64 lacks).
+inline unsigned count_bits(std::uint64_t m) noexcept {
+    m = m - ((m >> 1) & 0x5555555555555555ull);
+    m = (m & 0x3333333333333333ull) + ((m >> 2) & 0x3333333333333333ull);
+    m = (m + (m >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return static_cast<unsigned>((m * 0x0101010101010101ull) >> 56);
+}
+
+// Writes base + the index of each set bit of m, in order, at out, and returns the end of
+// them. Eight at a time without a test per bit (a loop over the bits ends at an
+// unpredictable count): up to 7 entries past the end are written (garbage within base ..
+// base + 63), so out needs 7 spare entries.
+inline std::uint32_t* list_bits(std::uint32_t* out, std::uint32_t base, std::uint64_t m) noexcept {
+    std::uint32_t* const end = out + count_bits(m);
+    constexpr std::uint64_t kTop = std::uint64_t{1} << 63;  // m | kTop: no zero argument once m runs out
+    do {
+        for (int i = 0; i < 8; ++i) {
+            out[i] = base + static_cast<std::uint32_t>(std::countr_zero(m | kTop));
+            m &= m - 1;
+        }
+        out += 8;
+    } while (out < end);
+    return end;
+}
+
 // The bits of word k of a row that lie within columns lo .. hi.
 inline std::uint64_t word_mask(std::size_t k, int lo, int hi) noexcept {
     const long base = static_cast<long>(k) * 64;
@@ -84,7 +110,7 @@ Simulator::Simulator(Scene scene)
     prev_marks_.assign(bitmap_words, 0);
     dirty_.assign(bitmap_words, 0);
     zero_row_.assign(words_, 0);
-    dirty_list_.resize(n);
+    dirty_list_.resize(n + 8);  // list_bits() writes up to 7 past the end
     polys_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) polys_[o].resize(scene_.objects[o].pieces.size());
     rects_.resize(scene_.objects.size());
@@ -350,14 +376,11 @@ void Simulator::render(bool all_rows) {
             const std::uint64_t dk = c[k] | p[k];
             d[k] = dk;
             p[k] = 0;  // read for the last time (cleared here rather than in a pass of its own)
-            for (std::uint64_t m = dk; m != 0; m &= m - 1) {
-                const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                next_[i] = bg_[i];
-                *listed++ = static_cast<std::uint32_t>(i);
-            }
+            if (dk != 0) listed = list_bits(listed, static_cast<std::uint32_t>(base + k * 64), dk);
         }
     }
     dirty_n_ = static_cast<std::size_t>(listed - dirty_list_.data());
+    for (std::size_t j = 0; j < dirty_n_; ++j) next_[dirty_list_[j]] = bg_[dirty_list_[j]];
     // Each object over what lies behind it: I = I (1 - b) + sum_k b_k I_k, b = sum_k b_k, its
     // pieces' coverages (they never overlap, so b is the object's own coverage), evaluated only
     // at the dirty pixels.
@@ -430,6 +453,8 @@ void Simulator::render(bool all_rows) {
                 near_cells[near_n++] = static_cast<std::size_t>(col - acc.x0);
         const std::size_t first = static_cast<std::size_t>(r.x0 - acc.x0);
         const int ry0 = std::max(r.y0, dirty_y0_), ry1 = std::min(r.y1, dirty_y1_);  // walked rows are dirty rows
+        const __m128d one = _mm_set_sd(1.0), lev = _mm_set_sd(level);
+        const __m128d snap_lo = _mm_set_sd(kSnap), snap_hi = _mm_set_sd(1.0 - kSnap);
         for (int y = ry0; y <= ry1; ++y) {
             const std::size_t row = static_cast<std::size_t>(y - acc.y0);
             double* ac = acc.cov.data() + row * cells;
@@ -440,32 +465,40 @@ void Simulator::render(bool all_rows) {
                 ac[near_cells[i]] = 0;
                 if (multi) ai[near_cells[i]] = 0;
             }
-            double b = 0, s = 0;
-            b += ac[first];
+            // The sums b (coverage) and s (intensity-weighted, a checkerboard's) are kept in
+            // the low lane of SSE2 registers (the high lane is 0 and unused), so that the
+            // snap to 1 and the choice between the composited and the old value are masks
+            // (compare, and, or): GCC makes jumps of such selects on doubles, and whether a
+            // dirty pixel is covered, and wholly, is unpredictable. Every operation is the
+            // scalar one of the same values (add, sub, mul of the low lanes), so the values
+            // are those the branches give.
+            const __m128d zero = _mm_setzero_pd();
+            __m128d b = _mm_add_sd(zero, _mm_load_sd(ac + first)), s = zero;
             ac[first] = 0;
             if (multi) {
-                s += ai[first];
+                s = _mm_add_sd(s, _mm_load_sd(ai + first));
                 ai[first] = 0;
             }
             for (std::size_t j = 0; j < acc.words; ++j)
                 for (std::uint64_t m = d[j] & inside_[j]; m != 0; m &= m - 1) {
                     const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                    b += ac[c];
+                    b = _mm_add_sd(b, _mm_load_sd(ac + c));
                     ac[c] = 0;
                     if (multi) {
-                        s += ai[c];
+                        s = _mm_add_sd(s, _mm_load_sd(ai + c));
                         ai[c] = 0;
                     }
-                    // Composited where covered, without a branch (the same value as a branch
-                    // would store).
-                    const double bc = b >= 1.0 - kSnap ? 1.0 : b;
-                    const double old = out[c];
-                    const double v = old * (1.0 - bc) + (multi ? s : bc * level);
-                    out[c] = b > kSnap ? v : old;
-                    b += ac[c + 1];
+                    // Composited where covered (b > kSnap), with b >= 1 - kSnap taken as 1.
+                    const __m128d whole = _mm_cmpge_sd(b, snap_hi);
+                    const __m128d bc = _mm_or_pd(_mm_and_pd(whole, one), _mm_andnot_pd(whole, b));
+                    const __m128d old = _mm_load_sd(out + c);
+                    const __m128d v = _mm_add_sd(_mm_mul_sd(old, _mm_sub_sd(one, bc)), multi ? s : _mm_mul_sd(bc, lev));
+                    const __m128d covered = _mm_cmpgt_sd(b, snap_lo);
+                    _mm_store_sd(out + c, _mm_or_pd(_mm_and_pd(covered, v), _mm_andnot_pd(covered, old)));
+                    b = _mm_add_sd(b, _mm_load_sd(ac + c + 1));
                     ac[c + 1] = 0;
                     if (multi) {
-                        s += ai[c + 1];
+                        s = _mm_add_sd(s, _mm_load_sd(ai + c + 1));
                         ai[c + 1] = 0;
                     }
                 }
