@@ -5,10 +5,12 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
-#include <emmintrin.h>  // SSE2 (baseline x86-64): branch-free selects in the compositing
 #include <set>
 #include <stdexcept>
 #include <string>
+#ifdef __SSE2__
+#include <emmintrin.h>  // SSE2 (baseline x86-64): the compositing's selects without jumps
+#endif
 
 #include "evcorner/sim/coverage.hpp"
 #include "evcorner/sim/coverage_walk.hpp"
@@ -77,6 +79,40 @@ inline std::uint32_t* list_bits(std::uint32_t* out, std::uint32_t base, std::uin
     } while (out < end);
     return end;
 }
+
+// A running sum of the compositing (coverage, or a checkerboard's intensity-weighted
+// coverage) and the compositing of one pixel: out = b > kSnap ? out (1 - bc) + add : out,
+// bc = b >= 1 - kSnap ? 1 : b, add = multi ? s : bc * level. With SSE2 the sums are kept in
+// the low lane of a register (the high one is 0 and unused), so that the snap to 1 and the
+// choice between the composited and the old value are masks (compare, and, or): GCC makes
+// jumps of such selects on doubles, and whether a dirty pixel is covered, and wholly, is
+// unpredictable. Every arithmetic operation is the scalar one of the same values, so the
+// results are those of the plain code (the fallback without SSE2).
+#ifdef __SSE2__
+using Sum = __m128d;
+inline Sum sum_zero() noexcept { return _mm_setzero_pd(); }
+inline Sum sum_add(Sum a, const double* cell) noexcept { return _mm_add_sd(a, _mm_load_sd(cell)); }
+inline void composite(double* out, Sum b, Sum s, bool multi, double level) noexcept {
+    const __m128d one = _mm_set_sd(1.0);
+    const __m128d whole = _mm_cmpge_sd(b, _mm_set_sd(1.0 - kSnap));
+    const __m128d bc = _mm_or_pd(_mm_and_pd(whole, one), _mm_andnot_pd(whole, b));
+    const __m128d old = _mm_load_sd(out);
+    const __m128d v = _mm_add_sd(_mm_mul_sd(old, _mm_sub_sd(one, bc)), multi ? s : _mm_mul_sd(bc, _mm_set_sd(level)));
+    const __m128d covered = _mm_cmpgt_sd(b, _mm_set_sd(kSnap));
+    _mm_store_sd(out, _mm_or_pd(_mm_and_pd(covered, v), _mm_andnot_pd(covered, old)));
+}
+#else
+struct Sum {
+    double v;
+};
+inline Sum sum_zero() noexcept { return {0.0}; }
+inline Sum sum_add(Sum a, const double* cell) noexcept { return {a.v + *cell}; }
+inline void composite(double* out, Sum b, Sum s, bool multi, double level) noexcept {
+    if (b.v <= kSnap) return;
+    const double bc = b.v >= 1.0 - kSnap ? 1.0 : b.v;
+    *out = *out * (1.0 - bc) + (multi ? s.v : bc * level);
+}
+#endif
 
 // The bits of word k of a row that lie within columns lo .. hi.
 inline std::uint64_t word_mask(std::size_t k, int lo, int hi) noexcept {
@@ -453,8 +489,6 @@ void Simulator::render(bool all_rows) {
                 near_cells[near_n++] = static_cast<std::size_t>(col - acc.x0);
         const std::size_t first = static_cast<std::size_t>(r.x0 - acc.x0);
         const int ry0 = std::max(r.y0, dirty_y0_), ry1 = std::min(r.y1, dirty_y1_);  // walked rows are dirty rows
-        const __m128d one = _mm_set_sd(1.0), lev = _mm_set_sd(level);
-        const __m128d snap_lo = _mm_set_sd(kSnap), snap_hi = _mm_set_sd(1.0 - kSnap);
         for (int y = ry0; y <= ry1; ++y) {
             const std::size_t row = static_cast<std::size_t>(y - acc.y0);
             double* ac = acc.cov.data() + row * cells;
@@ -465,40 +499,26 @@ void Simulator::render(bool all_rows) {
                 ac[near_cells[i]] = 0;
                 if (multi) ai[near_cells[i]] = 0;
             }
-            // The sums b (coverage) and s (intensity-weighted, a checkerboard's) are kept in
-            // the low lane of SSE2 registers (the high lane is 0 and unused), so that the
-            // snap to 1 and the choice between the composited and the old value are masks
-            // (compare, and, or): GCC makes jumps of such selects on doubles, and whether a
-            // dirty pixel is covered, and wholly, is unpredictable. Every operation is the
-            // scalar one of the same values (add, sub, mul of the low lanes), so the values
-            // are those the branches give.
-            const __m128d zero = _mm_setzero_pd();
-            __m128d b = _mm_add_sd(zero, _mm_load_sd(ac + first)), s = zero;
+            Sum b = sum_add(sum_zero(), ac + first), s = sum_zero();
             ac[first] = 0;
             if (multi) {
-                s = _mm_add_sd(s, _mm_load_sd(ai + first));
+                s = sum_add(s, ai + first);
                 ai[first] = 0;
             }
             for (std::size_t j = 0; j < acc.words; ++j)
                 for (std::uint64_t m = d[j] & inside_[j]; m != 0; m &= m - 1) {
                     const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                    b = _mm_add_sd(b, _mm_load_sd(ac + c));
+                    b = sum_add(b, ac + c);
                     ac[c] = 0;
                     if (multi) {
-                        s = _mm_add_sd(s, _mm_load_sd(ai + c));
+                        s = sum_add(s, ai + c);
                         ai[c] = 0;
                     }
-                    // Composited where covered (b > kSnap), with b >= 1 - kSnap taken as 1.
-                    const __m128d whole = _mm_cmpge_sd(b, snap_hi);
-                    const __m128d bc = _mm_or_pd(_mm_and_pd(whole, one), _mm_andnot_pd(whole, b));
-                    const __m128d old = _mm_load_sd(out + c);
-                    const __m128d v = _mm_add_sd(_mm_mul_sd(old, _mm_sub_sd(one, bc)), multi ? s : _mm_mul_sd(bc, lev));
-                    const __m128d covered = _mm_cmpgt_sd(b, snap_lo);
-                    _mm_store_sd(out + c, _mm_or_pd(_mm_and_pd(covered, v), _mm_andnot_pd(covered, old)));
-                    b = _mm_add_sd(b, _mm_load_sd(ac + c + 1));
+                    composite(out + c, b, s, multi, level);  // where covered (b > kSnap)
+                    b = sum_add(b, ac + c + 1);
                     ac[c + 1] = 0;
                     if (multi) {
-                        s = _mm_add_sd(s, _mm_load_sd(ai + c + 1));
+                        s = sum_add(s, ai + c + 1);
                         ai[c + 1] = 0;
                     }
                 }
@@ -717,8 +737,9 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         // cross() leaves them so, each a whole threshold of at least 0.01 C beyond the value
         // that reached the last level), so a rise cannot reach ioff_ nor a fall ion_: the
         // pixel crosses exactly when its new value is outside the two, whichever way it
-        // moved. Tested without a branch on the direction, which is unpredictable.
-        if ((b < ion_[p]) & (b > ioff_[p])) return;
+        // moved. Tested without a branch on the direction, which is unpredictable (and with
+        // '&', not '&&', so that the two comparisons make one jump).
+        if ((static_cast<int>(b < ion_[p]) & static_cast<int>(b > ioff_[p])) != 0) return;
         // A crossing. Where the pixel also changed in the step before, the parabola through
         // its three values tells how far the crossing's time would move if I bends like it;
         // within the tolerance the straight line is kept without a sample. A pixel that
