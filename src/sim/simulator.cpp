@@ -8,6 +8,9 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#ifdef __SSE2__
+#include <emmintrin.h>  // SSE2 (baseline x86-64): the compositing's selects without jumps
+#endif
 
 #include "evcorner/sim/coverage.hpp"
 #include "evcorner/sim/coverage_walk.hpp"
@@ -52,6 +55,65 @@ inline void set_range(std::uint64_t* row, int lo, int hi) noexcept {
     row[wh] |= mh;
 }
 
+// The number of set bits (without the popcnt instruction, which the baseline x86-64 lacks).
+inline unsigned count_bits(std::uint64_t m) noexcept {
+    m = m - ((m >> 1) & 0x5555555555555555ull);
+    m = (m & 0x3333333333333333ull) + ((m >> 2) & 0x3333333333333333ull);
+    m = (m + (m >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return static_cast<unsigned>((m * 0x0101010101010101ull) >> 56);
+}
+
+// Writes base + the index of each set bit of m, in order, at out, and returns the end of
+// them. Eight at a time without a test per bit (a loop over the bits ends at an
+// unpredictable count): up to 7 entries past the end are written (garbage within base ..
+// base + 63), so out needs 7 spare entries.
+inline std::uint32_t* list_bits(std::uint32_t* out, std::uint32_t base, std::uint64_t m) noexcept {
+    std::uint32_t* const end = out + count_bits(m);
+    constexpr std::uint64_t kTop = std::uint64_t{1} << 63;  // m | kTop: no zero argument once m runs out
+    do {
+        for (int i = 0; i < 8; ++i) {
+            out[i] = base + static_cast<std::uint32_t>(std::countr_zero(m | kTop));
+            m &= m - 1;
+        }
+        out += 8;
+    } while (out < end);
+    return end;
+}
+
+// A running sum of the compositing (coverage, or a checkerboard's intensity-weighted
+// coverage) and the compositing of one pixel: out = b > kSnap ? out (1 - bc) + add : out,
+// bc = b >= 1 - kSnap ? 1 : b, add = multi ? s : bc * level. With SSE2 the sums are kept in
+// the low lane of a register (the high one is 0 and unused), so that the snap to 1 and the
+// choice between the composited and the old value are masks (compare, and, or): GCC makes
+// jumps of such selects on doubles, and whether a dirty pixel is covered, and wholly, is
+// unpredictable. Every arithmetic operation is the scalar one of the same values, so the
+// results are those of the plain code (the fallback without SSE2).
+#ifdef __SSE2__
+using Sum = __m128d;
+inline Sum sum_zero() noexcept { return _mm_setzero_pd(); }
+inline Sum sum_add(Sum a, const double* cell) noexcept { return _mm_add_sd(a, _mm_load_sd(cell)); }
+inline void composite(double* out, Sum b, Sum s, bool multi, double level) noexcept {
+    const __m128d one = _mm_set_sd(1.0);
+    const __m128d whole = _mm_cmpge_sd(b, _mm_set_sd(1.0 - kSnap));
+    const __m128d bc = _mm_or_pd(_mm_and_pd(whole, one), _mm_andnot_pd(whole, b));
+    const __m128d old = _mm_load_sd(out);
+    const __m128d v = _mm_add_sd(_mm_mul_sd(old, _mm_sub_sd(one, bc)), multi ? s : _mm_mul_sd(bc, _mm_set_sd(level)));
+    const __m128d covered = _mm_cmpgt_sd(b, _mm_set_sd(kSnap));
+    _mm_store_sd(out, _mm_or_pd(_mm_and_pd(covered, v), _mm_andnot_pd(covered, old)));
+}
+#else
+struct Sum {
+    double v;
+};
+inline Sum sum_zero() noexcept { return {0.0}; }
+inline Sum sum_add(Sum a, const double* cell) noexcept { return {a.v + *cell}; }
+inline void composite(double* out, Sum b, Sum s, bool multi, double level) noexcept {
+    if (b.v <= kSnap) return;
+    const double bc = b.v >= 1.0 - kSnap ? 1.0 : b.v;
+    *out = *out * (1.0 - bc) + (multi ? s.v : bc * level);
+}
+#endif
+
 // The bits of word k of a row that lie within columns lo .. hi.
 inline std::uint64_t word_mask(std::size_t k, int lo, int hi) noexcept {
     const long base = static_cast<long>(k) * 64;
@@ -84,6 +146,7 @@ Simulator::Simulator(Scene scene)
     prev_marks_.assign(bitmap_words, 0);
     dirty_.assign(bitmap_words, 0);
     zero_row_.assign(words_, 0);
+    dirty_list_.resize(n + 8);  // list_bits() writes up to 7 past the end
     polys_.resize(scene_.objects.size());
     for (std::size_t o = 0; o < scene_.objects.size(); ++o) polys_[o].resize(scene_.objects[o].pieces.size());
     rects_.resize(scene_.objects.size());
@@ -335,25 +398,25 @@ void Simulator::render(bool all_rows) {
         dirty_y0_ = std::min(cur_y0_, prev_y0_);
         dirty_y1_ = std::max(cur_y1_, prev_y1_);
     }
-    // The dirty pixels start from the background.
+    // The dirty pixels start from the background, and are listed in row-major order
+    // (emit_crossings() reads the list).
     const std::size_t w = static_cast<std::size_t>(w_);
+    std::uint32_t* listed = dirty_list_.data();
     for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
         std::uint64_t* d = row_bits(dirty_, y);
-        if (!all_rows) {
-            const std::uint64_t* c = row_bits(cur_marks_, y);
-            std::uint64_t* p = row_bits(prev_marks_, y);
-            for (std::size_t k = 0; k < words_; ++k) {
-                d[k] = c[k] | p[k];
-                p[k] = 0;  // read for the last time (cleared here rather than in a pass of its own)
-            }
-        }
+        // (Every row: the dirty bits kept, with zero_row_ for the marks to clear; it stays zero.)
+        const std::uint64_t* c = row_bits(all_rows ? dirty_ : cur_marks_, y);
+        std::uint64_t* p = all_rows ? zero_row_.data() : row_bits(prev_marks_, y);
         const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (std::size_t k = 0; k < words_; ++k)
-            for (std::uint64_t m = d[k]; m != 0; m &= m - 1) {
-                const std::size_t i = base + k * 64 + static_cast<std::size_t>(std::countr_zero(m));
-                next_[i] = bg_[i];
-            }
+        for (std::size_t k = 0; k < words_; ++k) {
+            const std::uint64_t dk = c[k] | p[k];
+            d[k] = dk;
+            p[k] = 0;  // read for the last time (cleared here rather than in a pass of its own)
+            if (dk != 0) listed = list_bits(listed, static_cast<std::uint32_t>(base + k * 64), dk);
+        }
     }
+    dirty_n_ = static_cast<std::size_t>(listed - dirty_list_.data());
+    for (std::size_t j = 0; j < dirty_n_; ++j) next_[dirty_list_[j]] = bg_[dirty_list_[j]];
     // Each object over what lies behind it: I = I (1 - b) + sum_k b_k I_k, b = sum_k b_k, its
     // pieces' coverages (they never overlap, so b is the object's own coverage), evaluated only
     // at the dirty pixels.
@@ -377,31 +440,21 @@ void Simulator::render(bool all_rows) {
         ObjectAcc& acc = acc_[o];
         const std::size_t cells = acc.words * 64;
         const std::size_t kw = static_cast<std::size_t>(acc.x0) / 64;  // the window's first sensor word
-        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row),
-        // and the columns just outside them that its walk may write by rounding (r.x0 - 1 and
-        // r.x1 + 1, r.x1 + 2; walk_object()), widened by one on each side.
+        // The object's columns r.x0 .. r.x1 in each word of the window (the same in every row).
         inside_.resize(std::max(inside_.size(), acc.words));
-        near_.resize(std::max(near_.size(), acc.words));
-        for (std::size_t j = 0; j < acc.words; ++j) {
-            inside_[j] = word_mask(kw + j, r.x0, r.x1);
-            near_[j] = word_mask(kw + j, r.x0 - 2, r.x0 - 1) | word_mask(kw + j, r.x1 + 1, r.x1 + 3);
-        }
-        for (int y = r.y0; y <= r.y1; ++y) {
-            const std::size_t row = static_cast<std::size_t>(y - acc.y0);
-            double* ac = acc.cov.data() + row * cells;
-            double* ai = multi ? acc.val.data() + row * cells : nullptr;
-            double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
-            const bool in_dirty = y >= dirty_y0_ && y <= dirty_y1_;
-            const std::uint64_t* d = in_dirty ? row_bits(dirty_, y) + kw : zero_row_.data();
-            // The running sums over the window's cells, in column order: adding 0 leaves a
-            // sum as it is, so only the cells the walk may have written are added; composited
-            // where the row is dirty. A still object's written cells are its written bits; a
-            // moving object's are among its marked pixels (all dirty) and the cells right of
-            // them, and column 0; those are read and cleared. Cells the walk wrote outside the
-            // object's columns (by rounding: near_) are cleared, not added; the others outside
-            // them hold 0 (the walk did not write them).
-            double b = 0, s = 0;
-            if (!moving) {
+        for (std::size_t j = 0; j < acc.words; ++j) inside_[j] = word_mask(kw + j, r.x0, r.x1);
+        if (!moving) {
+            for (int y = r.y0; y <= r.y1; ++y) {
+                const std::size_t row = static_cast<std::size_t>(y - acc.y0);
+                const double* ac = acc.cov.data() + row * cells;
+                const double* ai = multi ? acc.val.data() + row * cells : nullptr;
+                double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
+                const bool in_dirty = y >= dirty_y0_ && y <= dirty_y1_;
+                const std::uint64_t* d = in_dirty ? row_bits(dirty_, y) + kw : zero_row_.data();
+                // The running sums over the window's cells, in column order: adding 0 leaves a
+                // sum as it is, so only the cells the walk wrote (its written bits) are added;
+                // composited where the row is dirty.
+                double b = 0, s = 0;
                 const std::uint64_t* wr = acc.written.data() + row * acc.words;
                 for (std::size_t j = 0; j < acc.words; ++j) {
                     const std::uint64_t inside = inside_[j];
@@ -415,38 +468,60 @@ void Simulator::render(bool all_rows) {
                         out[c] = out[c] * (1.0 - bc) + (multi ? s : bc * level);
                     }
                 }
-                continue;
             }
-            std::uint64_t carry = kw > 0 && in_dirty ? d[-1] >> 63 : 0;  // the cell right of a dirty one
-            if (acc.x0 == 0) carry |= 1;                                  // column 0
-            for (std::size_t j = 0; j < acc.words; ++j) {
-                const std::uint64_t inside = inside_[j];
-                const std::uint64_t dm = d[j] & inside;
-                const std::uint64_t wm = d[j] | (d[j] << 1) | carry;
-                carry = d[j] >> 63;
-                for (std::uint64_t e = wm & near_[j]; e != 0; e &= e - 1) {
-                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(e));
-                    ac[c] = 0;
-                    if (multi) ai[c] = 0;
-                }
-                for (std::uint64_t m = wm & inside; m != 0; m &= m - 1) {
-                    const unsigned bit = static_cast<unsigned>(std::countr_zero(m));
-                    const std::size_t c = j * 64 + bit;
-                    b += ac[c];
+            continue;
+        }
+        // A moving object: the cells its walk wrote are its marked pixels (all dirty), the
+        // cell right of each, and column 0 (then r.x0 is 0), all within r.x0 - 2 .. r.x1 + 3.
+        // So the running sum at a dirty pixel c of the object's columns is that of the cells
+        // before it plus ac[c]: the sum is carried from dirty pixel to dirty pixel, adding at
+        // each its own cell and, after compositing it, the cell right of it, each read and
+        // cleared (a cell added twice holds 0 the second time; adding 0 leaves a sum as it
+        // is, so the nonzero cells are added in column order, as a dense running sum would).
+        // The first column's cell starts the sum (the cell right of a dirty r.x0 - 1, or
+        // column 0). The cells just outside the object's columns that the walk may write by
+        // rounding (r.x0 - 2, r.x0 - 1; r.x1 + 1 .. r.x1 + 3) are cleared, not added (the one
+        // right of r.x1 is added after the last compositing: harmless).
+        std::size_t near_cells[5];
+        std::size_t near_n = 0;
+        for (const int col : {r.x0 - 2, r.x0 - 1, r.x1 + 1, r.x1 + 2, r.x1 + 3})
+            if (col >= acc.x0 && col < acc.x0 + static_cast<int>(cells))
+                near_cells[near_n++] = static_cast<std::size_t>(col - acc.x0);
+        const std::size_t first = static_cast<std::size_t>(r.x0 - acc.x0);
+        const int ry0 = std::max(r.y0, dirty_y0_), ry1 = std::min(r.y1, dirty_y1_);  // walked rows are dirty rows
+        for (int y = ry0; y <= ry1; ++y) {
+            const std::size_t row = static_cast<std::size_t>(y - acc.y0);
+            double* ac = acc.cov.data() + row * cells;
+            double* ai = multi ? acc.val.data() + row * cells : nullptr;
+            double* out = &next_[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(acc.x0)];  // at column acc.x0
+            const std::uint64_t* d = row_bits(dirty_, y) + kw;
+            for (std::size_t i = 0; i < near_n; ++i) {
+                ac[near_cells[i]] = 0;
+                if (multi) ai[near_cells[i]] = 0;
+            }
+            Sum b = sum_add(sum_zero(), ac + first), s = sum_zero();
+            ac[first] = 0;
+            if (multi) {
+                s = sum_add(s, ai + first);
+                ai[first] = 0;
+            }
+            for (std::size_t j = 0; j < acc.words; ++j)
+                for (std::uint64_t m = d[j] & inside_[j]; m != 0; m &= m - 1) {
+                    const std::size_t c = j * 64 + static_cast<std::size_t>(std::countr_zero(m));
+                    b = sum_add(b, ac + c);
                     ac[c] = 0;
                     if (multi) {
-                        s += ai[c];
+                        s = sum_add(s, ai + c);
                         ai[c] = 0;
                     }
-                    // Composited where dirty and covered, without a branch (the same value as
-                    // a branch would store).
-                    const bool comp = ((dm >> bit) & 1u) != 0 && b > kSnap;
-                    const double bc = b >= 1.0 - kSnap ? 1.0 : b;
-                    const double old = out[c];
-                    const double v = old * (1.0 - bc) + (multi ? s : bc * level);
-                    out[c] = comp ? v : old;
+                    composite(out + c, b, s, multi, level);  // where covered (b > kSnap)
+                    b = sum_add(b, ac + c + 1);
+                    ac[c + 1] = 0;
+                    if (multi) {
+                        s = sum_add(s, ai + c + 1);
+                        ai[c + 1] = 0;
+                    }
                 }
-            }
         }
     }
 }
@@ -639,8 +714,7 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     }
     double worst = 0;
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
-    // The dirty pixels (render()) in row-major order; those whose value changed go on. Read
-    // from the bitmap here rather than listed by render() in a pass of their own.
+    // The dirty pixels (render()'s list, row-major order); those whose value changed go on.
     std::size_t changed = 0;
     auto pixel = [&](std::size_t p) {
         const double a = cur_[p], b = next_[p];
@@ -658,11 +732,14 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
             return;
         }
         worst = std::max(worst, d / den);
-        // Most pixels do not cross: nothing to do but note the change. (Both thresholds read
-        // and compared, without a branch on the direction, which is unpredictable.)
-        const bool up = b > a;
-        const bool below_on = b < ion_[p], above_off = b > ioff_[p];
-        if (up ? below_on : above_off) return;
+        // Most pixels do not cross: nothing to do but note the change. A ready pixel's value
+        // lies strictly between its thresholds (ioff_ < cur_ < ion_: so they are set, and
+        // cross() leaves them so, each a whole threshold of at least 0.01 C beyond the value
+        // that reached the last level), so a rise cannot reach ioff_ nor a fall ion_: the
+        // pixel crosses exactly when its new value is outside the two, whichever way it
+        // moved. Tested without a branch on the direction, which is unpredictable (and with
+        // '&', not '&&', so that the two comparisons make one jump).
+        if ((static_cast<int>(b < ion_[p]) & static_cast<int>(b > ioff_[p])) != 0) return;
         // A crossing. Where the pixel also changed in the step before, the parabola through
         // its three values tells how far the crossing's time would move if I bends like it;
         // within the tolerance the straight line is kept without a sample. A pixel that
@@ -682,14 +759,7 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         }
         refine(p, 0, kKeyEnd, a, b, false, ev);
     };
-    const std::size_t w = static_cast<std::size_t>(w_);
-    for (int y = dirty_y0_; y <= dirty_y1_; ++y) {
-        const std::uint64_t* dm = row_bits(dirty_, y);
-        const std::size_t base = static_cast<std::size_t>(y) * w;
-        for (std::size_t k = 0; k < words_; ++k)
-            for (std::uint64_t m = dm[k]; m != 0; m &= m - 1)
-                pixel(base + k * 64 + static_cast<std::size_t>(std::countr_zero(m)));
-    }
+    for (std::size_t i = 0; i < dirty_n_; ++i) pixel(dirty_list_[i]);
     changed_n_ = changed;
     stats_.max_step_change = std::max(stats_.max_step_change, worst / scene_.camera.contrast);
 }

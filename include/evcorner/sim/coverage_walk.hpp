@@ -38,14 +38,21 @@ void walk_coverage_edge(double x0, double y0, double x1, double y1, double sign,
     // Every row r0 .. r1 is crossed: r0 <= y0 < r0 + 1 (or r0 = 0 and y0 < 0 < y1) and
     // r1 < y1, so each row's part [ya, yb] below has yb > ya.
     if (r0 <= r1) sink.rows(r0, r1);
+    // The part's top and its x carry from row to row: in every row after r0, ya is the row
+    // line r (r > y0), which is the row before's yb (r < y1), so xa is the row before's xb,
+    // the same expression of the same values (one multiplication a row less).
+    double ya = std::max(y0, static_cast<double>(r0));
+    double xa = x0 + (ya - y0) * dxdy;
     for (int r = r0; r <= r1; ++r) {
-        const double ya = std::max(y0, static_cast<double>(r));
         const double yb = std::min(y1, static_cast<double>(r + 1));
-        if (yb <= ya) continue;
-        const double h = sign * (yb - ya);
-        const double h2 = Dual ? sign2 * (yb - ya) : 0.0;
-        const double xa = x0 + (ya - y0) * dxdy, xb = x0 + (yb - y0) * dxdy;
-        const double xl = std::min(xa, xb), xr = std::max(xa, xb);
+        const double xb = x0 + (yb - y0) * dxdy;
+        const double ya_row = ya, xa_row = xa;
+        ya = yb;
+        xa = xb;
+        if (yb <= ya_row) continue;
+        const double h = sign * (yb - ya_row);
+        const double h2 = Dual ? sign2 * (yb - ya_row) : 0.0;
+        const double xl = std::min(xa_row, xb), xr = std::max(xa_row, xb);
         auto row = sink.row(r);
         if (xr <= 0) {  // wholly left of the sensor: covers every pixel of the row to its right
             row.add(0, h, h2);

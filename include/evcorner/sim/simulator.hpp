@@ -165,7 +165,8 @@ private:
     std::vector<std::uint64_t> cur_marks_, prev_marks_, dirty_, zero_row_;
     int cur_y0_ = 0, cur_y1_ = -1, prev_y0_ = 0, prev_y1_ = -1, dirty_y0_ = 0, dirty_y1_ = -1;
     std::vector<std::uint64_t> inside_;  // render(): the composited object's columns, per window word
-    std::vector<std::uint64_t> near_;    // render(): the columns just outside them its walk may write
+    std::vector<std::uint32_t> dirty_list_;  // the dirty pixels, row-major (render() writes the first dirty_n_)
+    std::size_t dirty_n_ = 0;
     std::size_t changed_n_ = 0;  // the dirty pixels whose value changed in the last step (emit_crossings)
     // Per-pixel sampling: each object's first piece in a numbering of every object's pieces in
     // order (object_first_piece_, plus the end), the pixels each object can cover within the step (step_rect_), the placements of the
