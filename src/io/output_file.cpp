@@ -17,7 +17,8 @@ constexpr std::size_t kBufferSize = 1 << 20;
 std::string write_failed(int err) { return std::string("write failed: ") + std::strerror(err); }
 }  // namespace
 
-OutputFile::OutputFile(std::string path) : buf_(kBufferSize) {
+OutputFile::OutputFile(std::string path)
+    : buf_(std::make_unique_for_overwrite<char[]>(kBufferSize)), cap_(kBufferSize) {
     if (path == "-") {
         name_ = "<stdout>";
         fd_ = STDOUT_FILENO;
@@ -40,27 +41,32 @@ OutputFile::~OutputFile() {
 }
 
 void OutputFile::write(std::string_view bytes) {
-    if (bytes.size() > buf_.size() - used_) {
+    if (bytes.size() > cap_ - used_) {
         flush();
-        if (bytes.size() > buf_.size()) buf_.resize(bytes.size());
+        if (bytes.size() > cap_) grow(bytes.size());
     }
-    if (!bytes.empty()) std::memcpy(buf_.data() + used_, bytes.data(), bytes.size());  // data() may be null
+    if (!bytes.empty()) std::memcpy(buf_.get() + used_, bytes.data(), bytes.size());  // data() may be null
     used_ += bytes.size();
 }
 
 char* OutputFile::reserve(std::size_t n) {
-    if (n > buf_.size() - used_) {
+    if (n > cap_ - used_) {
         flush();
-        if (n > buf_.size()) buf_.resize(n);
+        if (n > cap_) grow(n);
     }
-    return buf_.data() + used_;
+    return buf_.get() + used_;
+}
+
+void OutputFile::grow(std::size_t n) {
+    buf_ = std::make_unique_for_overwrite<char[]>(n);  // empty: flush() came first
+    cap_ = n;
 }
 
 void OutputFile::flush() {
     if (fd_ < 0) return;
     std::size_t done = 0;
     while (done < used_) {
-        const ssize_t n = ::write(fd_, buf_.data() + done, used_ - done);
+        const ssize_t n = ::write(fd_, buf_.get() + done, used_ - done);
         if (n <= 0) {
             if (n < 0 && errno == EINTR) continue;
             const int err = n < 0 ? errno : EIO;
