@@ -216,6 +216,12 @@ TEST(EFastPaths, Avx2SearchFindsANewestPixel) {
     return efast_avx512::fires16_narrow(_mm512_load_si512(v));
 }
 
+// The radius-4 test by pairs of lengths (efast_avx512::fires20_paired) on the same layout.
+[[gnu::target(EVCORNER_AVX512_TARGET)]] bool circle20_fires_paired(const std::int64_t* t) {
+    static constexpr std::int64_t kOffsets[20] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19};
+    return efast_avx512::fires20_paired(Avx512Search::load20(t, kOffsets));
+}
+
 // Random circles of N pixels: many and few ties, planted arcs of 2..Lmax+1 newest pixels,
 // never-fired pixels; the vector test must equal the definition on every one.
 template <int N, int Lmin, int Lmax, class Test>
@@ -244,6 +250,7 @@ TEST(EFastPaths, Avx512CircleTestsMatchTheDefinition) {
         GTEST_SKIP() << "no AVX-512 (F, VL, BW, DQ) on this CPU";
     vector_circle_test_matches<16, 3, 6>(circle16_fires_avx512, 7);
     vector_circle_test_matches<16, 3, 6>(circle16_fires_narrow, 9);
+    vector_circle_test_matches<20, 4, 8>(circle20_fires_paired, 10);
     vector_circle_test_matches<20, 4, 8>(circle20_fires_avx512, 8);
 }
 #endif

@@ -152,6 +152,37 @@ template <int J>
     return !_kortestc_mask16_u8(none, none);  // kortestw's carry: all ones
 }
 
+/// Whether the radius-4 circle (64-bit, Avx512Search's layout: 32 lanes, lane m holding
+/// t[m mod 20]) has an arc of 4..8 pixels all strictly newer than the rest, by the same
+/// pairing: some lane with m_4 > R_5, m_6 > R_7 or m_8 > R_8. R_8 = the 12-window of
+/// maxima rotated by 8, R_7 = max(R_8, t[s+7]), R_5 = max(R_7, t[s+5], t[s+6]).
+[[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline bool fires20_paired(
+    const Avx512Search::Circle20& t) noexcept {
+    using C = Avx512Search::Circle20;
+    constexpr bool kMin = false, kMax = true;
+    const C r1 = t.rot<1>();
+    const C m2 = Avx512Search::lanes<kMin>(t, r1);
+    const C m4 = Avx512Search::lanes<kMin>(m2, m2.rot<2>());
+    const C m6 = Avx512Search::lanes<kMin>(m4, m2.rot<4>());
+    const C m8 = Avx512Search::lanes<kMin>(m4, m4.rot<4>());
+    const C w2 = Avx512Search::lanes<kMax>(t, r1);
+    const C w4 = Avx512Search::lanes<kMax>(w2, w2.rot<2>());
+    const C w8 = Avx512Search::lanes<kMax>(w4, w4.rot<4>());
+    const C w12 = Avx512Search::lanes<kMax>(w8, w4.rot<8>());
+    const C rest8 = w12.rot<8>();
+    const C rest7 = Avx512Search::lanes<kMax>(rest8, t.rot<7>());
+    const C rest5 = Avx512Search::lanes<kMax>(rest7, w2.rot<5>());
+    // All of the first 20 lanes (three registers; lanes 20..23 repeat 0..3) "oldest <=
+    // rest" for the three pairs: one chain of masked compares.
+    __mmask8 none = _mm512_cmple_epi64_mask(m8.v[0], rest8.v[0]);
+    for (int i = 0; i < 3; ++i) {
+        if (i > 0) none = _mm512_mask_cmple_epi64_mask(none, m8.v[i], rest8.v[i]);
+        none = _mm512_mask_cmple_epi64_mask(none, m6.v[i], rest7.v[i]);
+        none = _mm512_mask_cmple_epi64_mask(none, m4.v[i], rest5.v[i]);
+    }
+    return !_kortestc_mask8_u8(none, none);
+}
+
 // An octet of cells q narrowed to 32 bits (u = q - lo, saturated); `outside` gets the
 // lanes of fired cells whose u is not in [0, 2^31).
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::always_inline]] inline __m256i narrow8(__m512i q, __m512i lo,
@@ -194,8 +225,9 @@ template <int J>
     const __m256i n1 = narrow8(join(quad<kCircle3, 8>(r3), quad<kCircle3, 12>(r3)), lo, out1);
     if (!_kortestz_mask8_u8(out0, out1)) [[unlikely]]  // one kortestb, not two kmovb and an OR
         return corner_exact(centre, stride);
-    return fires16_narrow(_mm512_inserti64x4(_mm512_castsi256_si512(n0), n1, 1)) &&
-           Avx512Search::fires<20, 4, 8>(load20(Rows<4>(centre, stride, three_strides)));
+    if (!fires16_narrow(_mm512_inserti64x4(_mm512_castsi256_si512(n0), n1, 1))) [[likely]]  // 92 % of the events
+        return false;
+    return fires20_paired(load20(Rows<4>(centre, stride, three_strides)));
 }
 
 }  // namespace evcorner::efast_avx512
