@@ -1,6 +1,8 @@
 #pragma once
-// eFAST's AVX-512 per-event loads: the two circles of int64 SAE cells into the vector
-// layouts of Avx512Search (arc_test.hpp), addressed by rows.
+// eFAST's AVX-512 per-event path: the two circles of int64 SAE cells loaded by rows into
+// vector registers (the layouts of Avx512Search, arc_test.hpp), and the arc tests on
+// them: radius 3 on 32-bit times narrowed at load, radius 4 on the 64-bit cells, both
+// with the arc lengths taken in pairs (corner(), below).
 //
 // A circle pixel (dx, dy) lies at centre + dy * width + dx. The seven (radius 3) or nine
 // (radius 4) row pointers are formed from the centre and one or two loop-invariant row
