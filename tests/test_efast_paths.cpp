@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <random>
@@ -81,6 +82,102 @@ TEST(EFastPaths, AgreeOnTheBundledSample) {
                        kDavis240);
 }
 
+// The AVX-512 path tests the radius-3 circle on 32-bit times relative to the event's,
+// exact within [-2^30, 2^30) us of it, and sends any other event to its 64-bit test
+// (efast_avx512.hpp). These streams put fired circle pixels beyond that range: gaps of
+// about and above 2^30 us, times near both ends of the SAE's range.
+constexpr std::int64_t kNarrow = std::int64_t{1} << 30;
+
+// How many of the oracle's corners have a fired radius-3 pixel (of the event's polarity)
+// outside [t - 2^30, t + 2^30): the corners only the exact test decides.
+std::size_t corners_beyond_the_narrow_range(const std::vector<Event>& events, SensorSize s) {
+    naive::EFastNaive oracle(s);
+    std::vector<std::int64_t> last[2];
+    std::vector<bool> fired[2];
+    for (int p = 0; p < 2; ++p) {
+        last[p].assign(static_cast<std::size_t>(s.pixels()), 0);
+        fired[p].assign(static_cast<std::size_t>(s.pixels()), false);
+    }
+    std::size_t n = 0;
+    for (const Event& e : events) {
+        const std::size_t i = static_cast<std::size_t>(e.y) * static_cast<std::size_t>(s.width) + e.x;
+        last[e.p][i] = e.t;
+        fired[e.p][i] = true;
+        if (!oracle.process(e)) continue;
+        bool beyond = false;
+        for (const Offset& o : kCircle3) {
+            const std::size_t j = static_cast<std::size_t>((e.y + o.dy) * s.width + e.x + o.dx);
+            beyond |= fired[e.p][j] && (last[e.p][j] < e.t - kNarrow || last[e.p][j] >= e.t + kNarrow);
+        }
+        n += beyond;
+    }
+    return n;
+}
+
+TEST(EFastPaths, AgreeAcrossGapsBeyondTheNarrowRange) {
+    const SensorSize s{240, 180};
+    // Gaps every 8000 events: just inside and just outside 2^30, 2^31, 2^40 us.
+    const std::int64_t gaps[] = {kNarrow - 3, kNarrow + 1, 2 * kNarrow, std::int64_t{1} << 40, kNarrow};
+    for (const std::int64_t start : {std::int64_t{0}, Sae::kMinTime, Sae::kMaxTime - (std::int64_t{1} << 42)}) {
+        std::vector<Event> events = blob_stream(s, 80000, 11);
+        std::int64_t shift = start;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            if (i > 0 && i % 8000 == 0) shift += gaps[(i / 8000) % std::size(gaps)];
+            events[i].t += shift;
+        }
+        ASSERT_LE(events.back().t, Sae::kMaxTime);
+        EXPECT_GT(corners_beyond_the_narrow_range(events, s), 20u) << "start " << start;
+        expect_paths_agree(events, s);
+    }
+}
+
+// Drawn: an arc on each circle (4 of 16, 5 of 20) fired at time `arc`, the rest of both
+// circles at time `rest` (or never, by default); then the event in the centre at time
+// `now`. The arc is newer than the rest at any distance in time, so it is a corner on
+// every path, although fired pixels far outside the 32-bit range would all narrow to
+// one value there (and to the never-fired pixels' one).
+void expect_old_arc_fires(std::int64_t arc, std::int64_t now, std::optional<std::int64_t> rest = std::nullopt) {
+    const SensorSize s{20, 20};
+    const int x0 = 10, y0 = 10;
+    std::vector<Event> events;
+    auto add = [&](std::int64_t t, int dx, int dy) {
+        events.push_back({t, static_cast<std::uint16_t>(x0 + dx), static_cast<std::uint16_t>(y0 + dy), 1});
+    };
+    for (int k = 0; k < 4; ++k) add(arc, kCircle3[k].dx, kCircle3[k].dy);
+    for (int k = 0; k < 5; ++k) add(arc, kCircle4[k].dx, kCircle4[k].dy);
+    if (rest) {
+        for (int k = 4; k < 16; ++k) add(*rest, kCircle3[k].dx, kCircle3[k].dy);
+        for (int k = 5; k < 20; ++k) add(*rest, kCircle4[k].dx, kCircle4[k].dy);
+    }
+    add(now, 0, 0);
+    naive::EFastNaive oracle(s);
+    std::vector<std::uint8_t> expected;
+    for (const Event& e : events) expected.push_back(oracle.process(e));
+    ASSERT_EQ(expected.back(), 1) << "arc " << arc << ", event " << now;
+    for (const std::string& path : efast_code_paths()) {
+        EFast det(s);
+        std::vector<std::uint8_t> got(events.size(), 7);
+        detect_on_path(path, det, events, got);
+        EXPECT_EQ(got, expected) << path << ": arc " << arc << ", event " << now;
+    }
+}
+
+TEST(EFastPaths, ArcFiredLongAgoAgainstNeverFiredPixels) {
+    const std::int64_t now = std::int64_t{1} << 41;
+    for (const std::int64_t age : {std::int64_t{1}, kNarrow - 1, kNarrow, kNarrow + 1, 2 * kNarrow, now})
+        expect_old_arc_fires(now - age, now);
+    for (const std::int64_t ahead : {std::int64_t{1}, kNarrow - 1, kNarrow, 2 * kNarrow})
+        expect_old_arc_fires(now + ahead, now);
+    expect_old_arc_fires(Sae::kMinTime, Sae::kMinTime + 5);
+    expect_old_arc_fires(Sae::kMinTime, Sae::kMaxTime);
+    expect_old_arc_fires(Sae::kMaxTime, Sae::kMinTime);
+    // Both the arc and the rest beyond the range, on either side of the event.
+    expect_old_arc_fires(now - 2 * kNarrow, now, now - 4 * kNarrow);
+    expect_old_arc_fires(now - kNarrow - 2, now, now - kNarrow - 3);
+    expect_old_arc_fires(now + 4 * kNarrow, now, now + 2 * kNarrow);
+    expect_old_arc_fires(now + 2 * kNarrow, now, now - 2 * kNarrow);
+}
+
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
 template <int N>
 void avx2_search_matches(std::uint32_t seed) {
@@ -111,6 +208,20 @@ TEST(EFastPaths, Avx2SearchFindsANewestPixel) {
     return Avx512Search::circle20_fires(t, kOffsets);
 }
 
+// The radius-3 test on 32-bit times (efast_avx512::fires16_narrow); never-fired pixels
+// (INT64_MIN here) as INT32_MIN, as the narrowing leaves them.
+[[gnu::target(EVCORNER_AVX512_TARGET)]] bool circle16_fires_narrow(const std::int64_t* t) {
+    alignas(64) std::int32_t v[16];
+    for (int k = 0; k < 16; ++k) v[k] = t[k] == INT64_MIN ? INT32_MIN : static_cast<std::int32_t>(t[k]);
+    return efast_avx512::fires16_narrow(_mm512_load_si512(v));
+}
+
+// The radius-4 test by pairs of lengths (efast_avx512::fires20_paired) on the same layout.
+[[gnu::target(EVCORNER_AVX512_TARGET)]] bool circle20_fires_paired(const std::int64_t* t) {
+    static constexpr std::int64_t kOffsets[20] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19};
+    return efast_avx512::fires20_paired(Avx512Search::load20(t, kOffsets));
+}
+
 // Random circles of N pixels: many and few ties, planted arcs of 2..Lmax+1 newest pixels,
 // never-fired pixels; the vector test must equal the definition on every one.
 template <int N, int Lmin, int Lmax, class Test>
@@ -138,6 +249,8 @@ TEST(EFastPaths, Avx512CircleTestsMatchTheDefinition) {
         !__builtin_cpu_supports("avx512bw") || !__builtin_cpu_supports("avx512dq"))
         GTEST_SKIP() << "no AVX-512 (F, VL, BW, DQ) on this CPU";
     vector_circle_test_matches<16, 3, 6>(circle16_fires_avx512, 7);
+    vector_circle_test_matches<16, 3, 6>(circle16_fires_narrow, 9);
+    vector_circle_test_matches<20, 4, 8>(circle20_fires_paired, 10);
     vector_circle_test_matches<20, 4, 8>(circle20_fires_avx512, 8);
 }
 #endif

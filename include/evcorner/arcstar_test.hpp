@@ -268,7 +268,8 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
 /// registers (as eFAST's AVX-512 path, Avx512Search): lane s holds the oldest of the L
 /// pixels from s and the newest of the N-L pixels before s (the rest of that arc), both
 /// grown one pixel per length from rotated copies of the circle; one subtraction per
-/// length (the sign of newest-of-rest minus oldest-of-arc) and one OR per two lengths.
+/// two lengths (the sign of newest-of-rest minus oldest-of-arc, the rest of the longer
+/// arc against the oldest of the shorter: separation2()) and ORs of the differences.
 /// No serial growth and no data-dependent branch. Only for code compiled for AVX-512.
 ///
 /// The circle is held as 32-bit times relative to the event's (order is all the test
@@ -354,6 +355,12 @@ struct ArcStarAvx512 {
         return {{_mm512_ternarylogic_epi32(a.v[0], b.v[0], c.v[0], 0xFE),
                  _mm512_ternarylogic_epi32(a.v[1], b.v[1], c.v[1], 0xFE)}};
     }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Lanes16 or2(const Lanes16& a, const Lanes16& b) noexcept {
+        return {_mm512_or_si512(a.v, b.v)};
+    }
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static Lanes20 or2(const Lanes20& a, const Lanes20& b) noexcept {
+        return {{_mm512_or_si512(a.v[0], b.v[0]), _mm512_or_si512(a.v[1], b.v[1])}};
+    }
     // Whether any lane has its sign bit set. (Lanes 20..31 of a Lanes20 hold the arcs from
     // starts 0..11 again: harmless.)
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static bool any_negative(const Lanes16& a) noexcept {
@@ -366,6 +373,16 @@ struct ArcStarAvx512 {
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto separation(const C& t) noexcept {
         return minus(newest_before<N, N - L>(t), oldest_from<N, L>(t));
     }
+    // Sign bit set in lane s iff the arc of L or the arc of L + 1 pixels from s is
+    // separating: (newest of the N - L - 1 pixels before s) - (oldest of the L from s) < 0.
+    // (If t[s+L] is older than the L-arc's oldest, the L-arc's rest is older than it too;
+    // else the (L+1)-arc has the same oldest and the shorter rest. The converse: the
+    // L-arc's oldest is at least the (L+1)-arc's, its rest at least the (L+1)-arc's rest.)
+    // One subtraction per two lengths (efast_avx512.hpp uses the same pairing).
+    template <int N, int L, class C>
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto separation2(const C& t) noexcept {
+        return minus(newest_before<N, N - L - 1>(t), oldest_from<N, L>(t));
+    }
     // Sign bit set in lane s iff some arc of a length in L..Hi (L <= Hi) from s is
     // separating. (The recursions repeat sub-expressions; the intrinsics are pure, so the
     // compiler computes each once.)
@@ -373,10 +390,12 @@ struct ArcStarAvx512 {
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto separating(const C& t) noexcept {
         static_assert(L <= Hi);
         if constexpr (Hi == L) return separation<N, L>(t);
-        else if constexpr (Hi == L + 1) return or3(separation<N, L>(t), separation<N, L>(t), separation<N, Hi>(t));
-        else if constexpr (Hi == L + 2)
-            return or3(separation<N, L>(t), separation<N, L + 1>(t), separation<N, Hi>(t));
-        else return or3(separation<N, L>(t), separation<N, L + 1>(t), separating<N, L + 2, Hi>(t));
+        else if constexpr (Hi == L + 1) return separation2<N, L>(t);
+        else if constexpr (Hi == L + 2) return or2(separation2<N, L>(t), separation<N, Hi>(t));
+        else if constexpr (Hi == L + 3) return or2(separation2<N, L>(t), separation2<N, L + 2>(t));
+        else if constexpr (Hi == L + 4)
+            return or3(separation2<N, L>(t), separation2<N, L + 2>(t), separation<N, Hi>(t));
+        else return or3(separation2<N, L>(t), separation2<N, L + 2>(t), separating<N, L + 4, Hi>(t));
     }
     template <int N, int Lmin, int Lmax, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline bool passes(const C& t, bool minority_only) noexcept {

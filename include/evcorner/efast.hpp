@@ -157,7 +157,8 @@ private:
         template <class Search>
         bool process(const Event& e) const noexcept {
             std::int64_t* const centre = plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x;
-            *centre = Sae::stored(e.t);  // the SAE update, border events included
+            const std::int64_t st = Sae::stored(e.t);
+            *centre = st;  // the SAE update, border events included
             if (e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
                 e.y >= height - kCircleMargin)
                 return false;
@@ -166,7 +167,7 @@ private:
             const std::ptrdiff_t w = width;
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
             if constexpr (std::is_same_v<Search, Avx512Search>) {
-                return efast_avx512::corner(centre, w * 8);
+                return efast_avx512::corner(centre, w * 8, st);
             } else
 #endif
             {
