@@ -210,9 +210,10 @@ template <int J>
 /// arc of 3..6 (on 32-bit times, above) and the radius-4 one with 4..8 (64-bit).
 /// `stride` is the row stride in bytes.
 // Not always_inline: it is called from View::process(), which has no target attribute;
-// detect_avx512's `flatten` inlines it there. (Tried: the radius-4 test out of line, as a
-// call, and with the stride made opaque once more before it so that its addresses are not
-// formed ahead of the radius-3 branch: both made the loop about 1.5x slower.)
+// detect_avx512's `flatten` inlines it there. (Tried before the 32-bit test: the radius-4
+// test out of line, as a call, and the stride made opaque once more by an `asm volatile`
+// before it: both made the loop about 1.5x slower. The plain `asm` on copies below, inside
+// the branch, makes it faster: wt-efast7, docs/performance.md.)
 [[gnu::target(EVCORNER_AVX512_TARGET)]] inline bool corner(const std::int64_t* centre, std::ptrdiff_t stride,
                                                            std::int64_t st) noexcept {
     // Opaque to the optimiser at every event: else GCC hoists stride + displacement for
@@ -229,7 +230,13 @@ template <int J>
         return corner_exact(centre, stride);
     if (!fires16_narrow(_mm512_inserti64x4(_mm512_castsi256_si512(n0), n1, 1))) [[likely]]  // 92 % of the events
         return false;
-    return fires20_paired(load20(Rows<4>(centre, stride, three_strides)));
+    // The radius-4 rows from copies of the centre and the stride that the optimiser
+    // cannot see through: else GCC forms some of their addresses ahead of the branch
+    // above, on the path of every event (about 6 instructions), for the 8 % that get here.
+    const std::int64_t* c4 = centre;
+    std::ptrdiff_t s4 = stride;
+    __asm__("" : "+r"(c4), "+r"(s4));
+    return fires20_paired(load20(Rows<4>(c4, s4, 3 * s4)));
 }
 
 }  // namespace evcorner::efast_avx512
