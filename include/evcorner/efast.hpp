@@ -128,11 +128,10 @@ public:
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
 
 private:
-    // The per-event path on plain values: planes, width, height.
+    // The per-event path on plain values: planes, width, the inner width and height.
     struct View {
         std::int64_t* plane[2];
         std::ptrdiff_t width;
-        int height;
         // The columns and rows whose circles lie on the sensor, counted from the margin
         // (0 on a sensor too small for any): one unsigned compare per coordinate.
         std::uint32_t inner_width, inner_height;
@@ -147,9 +146,8 @@ private:
             v.plane[0] = sae.plane(0);
             v.plane[1] = sae.plane(1);
             v.width = sae.size().width;
-            v.height = sae.size().height;
             v.inner_width = static_cast<std::uint32_t>(std::max<std::ptrdiff_t>(v.width - 2 * kCircleMargin, 0));
-            v.inner_height = static_cast<std::uint32_t>(std::max(v.height - 2 * kCircleMargin, 0));
+            v.inner_height = static_cast<std::uint32_t>(std::max(sae.size().height - 2 * kCircleMargin, 0));
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
             if constexpr (std::is_same_v<Search, Avx512Search>) {
                 for (int k = 0; k < 16; ++k) v.off3[k] = kCircle3[k].dy * v.width + kCircle3[k].dx;

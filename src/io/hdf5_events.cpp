@@ -129,17 +129,6 @@ auto quiet(F&& f) {
     return r;
 }
 
-// Loads libhdf5 (Hdf5Api::get) where it is not loaded yet; its failure is reported as
-// `Error` naming `file`.
-template <class Error>
-void open_hdf5(const std::string& file) {
-    try {
-        (void)Hdf5Api::get();
-    } catch (const std::runtime_error& e) {
-        throw Error(file, e.what());
-    }
-}
-
 // Why the last HDF5 call failed, from its error stack: the operating system's message
 // where HDF5 recorded one ("errno = 28, error message = 'No space left on device'"),
 // else the description of the innermost error (where it was detected). `err`: errno
@@ -205,7 +194,7 @@ struct Hdf5Reader::Impl {
 
 Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
     : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdin>" : path), options_(std::move(options)) {
-    open_hdf5<InputError>(name_);
+    load_for<Hdf5Api, InputError>(name_);
     if (path == "-") throw InputError(name_, "HDF5 files cannot be read from standard input");
     file_size_ = regular_file_size(path);
     if (!file_size_) throw InputError(name_, "cannot open: not a regular file, or missing");
@@ -476,13 +465,13 @@ struct Hdf5Writer::Impl {
 };
 
 bool Hdf5Writer::filter_available(int id) {
-    open_hdf5<OutputError>("HDF5 output");
+    load_for<Hdf5Api, OutputError>("HDF5 output");
     return quiet([&] { return H5Zfilter_avail(static_cast<H5Z_filter_t>(id)); }) > 0;
 }
 
 Hdf5Writer::Hdf5Writer(std::string path, Options options)
     : impl_(std::make_unique<Impl>()), name_(path == "-" ? "<stdout>" : path), options_(options) {
-    open_hdf5<OutputError>(name_);
+    load_for<Hdf5Api, OutputError>(name_);
     if (path == "-") throw OutputError(name_, "HDF5 files cannot go to standard output");
     if (options_.chunk_events == 0) options_.chunk_events = std::size_t{1} << 14;
     // HDF5 writes a temporary file in the target's folder (pending_file.hpp), renamed by close().

@@ -57,11 +57,7 @@ thread_local std::string g_matio_message;
 void matio_log(int /*level*/, char* message) { g_matio_message = message != nullptr ? message : ""; }
 // Also loads libmatio; its failure is an InputError naming `file`.
 void init_matio_log(const std::string& file) {
-    try {
-        (void)MatioApi::get();
-    } catch (const std::runtime_error& e) {
-        throw InputError(file, e.what());
-    }
+    load_for<MatioApi, InputError>(file);
     static std::once_flag once;
     std::call_once(once, [] { Mat_LogInitFunc("evcorner", matio_log); });
 }

@@ -17,8 +17,8 @@ constexpr std::size_t kBufferSize = 1 << 20;
 std::string write_failed(int err) { return std::string("write failed: ") + std::strerror(err); }
 }  // namespace
 
-OutputFile::OutputFile(std::string path)
-    : buf_(std::make_unique_for_overwrite<char[]>(kBufferSize)), cap_(kBufferSize) {
+OutputFile::OutputFile(std::string path) {
+    grow(kBufferSize);
     if (path == "-") {
         name_ = "<stdout>";
         fd_ = STDOUT_FILENO;

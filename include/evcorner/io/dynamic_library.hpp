@@ -15,7 +15,7 @@
 // silent one.
 // Internal: not installed.
 
-#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -64,5 +64,16 @@ struct Forwarder<R (*)(A...)> {
         return (Table::get().*Member)(a...);
     }
 };
+
+/// Loads Table (Table::get()) where it is not loaded yet; a failure becomes an Error
+/// (InputError, OutputError) naming `file`, the file that needed the library.
+template <class Table, class Error>
+void load_for(const std::string& file) {
+    try {
+        (void)Table::get();
+    } catch (const std::runtime_error& e) {
+        throw Error(file, e.what());
+    }
+}
 
 }  // namespace evcorner::io
