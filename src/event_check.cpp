@@ -1,8 +1,13 @@
 #include "evcorner/event_check.hpp"
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "evcorner/cpu_paths.hpp"
 
@@ -60,13 +65,15 @@ inline bool all_accepted(const Event* ev, std::size_t n, const EventLimits& l) n
     return n == 0 || (l.accepts(Event{min_t, max_x, max_y, max_p}) && l.accepts(Event{max_t, max_x, max_y, max_p}));
 }
 
-template <bool>
+// Blocks of events, each tested by Accepted (all_accepted() or all_accepted_avx512());
+// in the first block that fails, the first failing event.
+template <bool (*Accepted)(const Event*, std::size_t, const EventLimits&) noexcept>
 std::size_t first_invalid(std::span<const Event> events, const EventLimits& limits) noexcept {
     constexpr std::size_t kBlock = 1024;
     const std::size_t n = events.size();
     for (std::size_t at = 0; at < n; at += kBlock) {
         const std::size_t m = n - at < kBlock ? n - at : kBlock;
-        if (!all_accepted(events.data() + at, m, limits)) [[unlikely]]
+        if (!Accepted(events.data() + at, m, limits)) [[unlikely]]
             for (std::size_t i = at; i < at + m; ++i)
                 if (!limits.accepts(events[i])) return i;
     }
@@ -76,23 +83,109 @@ std::size_t first_invalid(std::span<const Event> events, const EventLimits& limi
 using Finder = std::size_t (*)(std::span<const Event>, const EventLimits&) noexcept;
 
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
+// The AVX-512 pass: four events per 512-bit load (an event is 16 bytes: t in the even
+// 64-bit lanes, x, y, p and three padding bytes in the odd ones), folded into running
+// extremes by four instructions: the least and the greatest t (masked to the even lanes),
+// the greatest 16-bit words (x and y) and the OR of the bytes (p <= 1 iff no bit of p
+// above the lowest is set). The padding bytes take part in none of the decisions. What
+// GCC's vectoriser makes of all_accepted() takes about 8.5 instructions per event; this
+// takes about 1.3 (issue 14: the check runs before every checked detect()).
+EVCORNER_AVX512_WARNINGS_OFF
+[[gnu::target(EVCORNER_AVX512_TARGET)]] bool all_accepted_avx512(const Event* ev, std::size_t n,
+                                                                 const EventLimits& l) noexcept {
+    static_assert(sizeof(Event) == 16 && offsetof(Event, t) == 0 && offsetof(Event, x) == 8 &&
+                  offsetof(Event, y) == 10 && offsetof(Event, p) == 12);
+    constexpr __mmask8 kTimes = 0x55;  // the even 64-bit lanes: t of each event
+    __m512i tmin = _mm512_set1_epi64(std::numeric_limits<std::int64_t>::max());
+    __m512i tmax = _mm512_set1_epi64(std::numeric_limits<std::int64_t>::min());
+    __m512i words = _mm512_setzero_si512(), bits = _mm512_setzero_si512();
+    const char* const base = reinterpret_cast<const char*>(ev);
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const __m512i v = _mm512_loadu_si512(base + i * sizeof(Event));
+        tmin = _mm512_mask_min_epi64(tmin, kTimes, tmin, v);
+        tmax = _mm512_mask_max_epi64(tmax, kTimes, tmax, v);
+        words = _mm512_max_epu16(words, v);
+        bits = _mm512_or_si512(bits, v);
+    }
+    if (i < n) {  // the last 1-3 events: a masked load, the missing lanes as zeros
+        const __mmask8 lanes = static_cast<__mmask8>((1u << (2 * (n - i))) - 1);
+        const __m512i v = _mm512_maskz_loadu_epi64(lanes, base + i * sizeof(Event));
+        tmin = _mm512_mask_min_epi64(tmin, lanes & kTimes, tmin, v);
+        tmax = _mm512_mask_max_epi64(tmax, lanes & kTimes, tmax, v);
+        words = _mm512_max_epu16(words, v);
+        bits = _mm512_or_si512(bits, v);
+    }
+    if (n == 0) return true;
+    // Fold the four odd lanes into one: the largest x and y, the OR of p.
+    alignas(64) std::uint16_t w[32];
+    alignas(64) std::uint8_t b[64];
+    _mm512_store_si512(w, words);
+    _mm512_store_si512(b, bits);
+    std::uint16_t max_x = 0, max_y = 0;
+    std::uint8_t or_p = 0;
+    for (int e = 0; e < 4; ++e) {
+        max_x = std::max(max_x, w[8 * e + 4]);
+        max_y = std::max(max_y, w[8 * e + 5]);
+        or_p = static_cast<std::uint8_t>(or_p | b[16 * e + 12]);
+    }
+    const std::int64_t min_t = _mm512_mask_reduce_min_epi64(kTimes, tmin);
+    const std::int64_t max_t = _mm512_mask_reduce_max_epi64(kTimes, tmax);
+    // or_p <= 1 iff every p <= 1.
+    return l.accepts(Event{min_t, max_x, max_y, or_p}) && l.accepts(Event{max_t, max_x, max_y, or_p});
+}
+EVCORNER_AVX512_WARNINGS_ON
+
 // flatten: the whole pass compiled for AVX2 here and nowhere else.
 [[gnu::target("avx2"), gnu::flatten]] std::size_t first_invalid_avx2(std::span<const Event> events,
                                                                       const EventLimits& limits) noexcept {
-    return first_invalid<true>(events, limits);
+    return first_invalid<all_accepted>(events, limits);
 }
-Finder choose() noexcept {
-    return cpu_runs_avx2() ? first_invalid_avx2 : first_invalid<false>;
+[[gnu::target(EVCORNER_AVX512_TARGET)]] std::size_t first_invalid_avx512(std::span<const Event> events,
+                                                                         const EventLimits& limits) noexcept {
+    return first_invalid<all_accepted_avx512>(events, limits);
 }
-#else
-Finder choose() noexcept { return first_invalid<false>; }
 #endif
+
+struct FinderPath {
+    const char* name;
+    Finder finder;
+};
+
+// The passes this CPU runs, fastest first.
+std::vector<FinderPath> finder_paths() {
+    std::vector<FinderPath> paths;
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    if (cpu_runs_avx512()) paths.push_back({"avx512", first_invalid_avx512});
+    if (cpu_runs_avx2()) paths.push_back({"avx2", first_invalid_avx2});
+#endif
+    paths.push_back({"portable", first_invalid<all_accepted>});
+    return paths;
+}
+
+const std::vector<FinderPath>& finders() {
+    static const std::vector<FinderPath> p = finder_paths();
+    return p;
+}
 
 }  // namespace
 
 std::size_t first_invalid_event(std::span<const Event> events, const EventLimits& limits) noexcept {
-    static const Finder finder = choose();
+    static const Finder finder = finders().front().finder;
     return finder(events, limits);
+}
+
+std::vector<std::string> event_check_paths() {
+    std::vector<std::string> names;
+    for (const FinderPath& p : finders()) names.emplace_back(p.name);
+    return names;
+}
+
+std::size_t first_invalid_event_on_path(std::string_view path, std::span<const Event> events,
+                                        const EventLimits& limits) {
+    for (const FinderPath& p : finders())
+        if (path == p.name) return p.finder(events, limits);
+    throw std::invalid_argument("event check path '" + std::string(path) + "' does not run on this CPU");
 }
 
 InvalidEvent::InvalidEvent(const Event& e, const EventLimits& limits, std::size_t index)

@@ -161,6 +161,63 @@ TEST(DetectorChecks, EveryEFastCodePathChecks) {
     }
 }
 
+// Every pass of first_invalid_event() this CPU runs finds the same first refused event as
+// a plain scan: batches of every length up to a few blocks (so every tail length of the
+// vector passes), one or two refused events of each kind (x, y, p, t below, t above) at
+// random places or none, padding bytes of every value, time limits set or open.
+TEST(DetectorChecks, EveryCheckPassFindsTheFirstRefusedEvent) {
+    const std::vector<std::string> paths = event_check_paths();
+    ASSERT_FALSE(paths.empty());
+    EXPECT_EQ(paths.back(), "portable");
+    std::mt19937_64 rng(11);
+    const SensorSize s{240, 180};
+    const EventLimits bounded{s, -1000, 1000000};
+    const EventLimits open{s};
+    std::size_t refused = 0, cases = 0;
+    for (int round = 0; round < 600; ++round) {
+        const std::size_t n = round < 40 ? static_cast<std::size_t>(round) : rng() % 2600;
+        std::vector<Event> ev(n);
+        for (Event& e : ev) {
+            // Random padding: fill the bytes first, then the fields.
+            std::uint64_t raw[2] = {rng(), rng()};
+            std::memcpy(&e, raw, sizeof e);
+            e.t = static_cast<std::int64_t>(rng() % 1000000);
+            e.x = static_cast<std::uint16_t>(rng() % 240);
+            e.y = static_cast<std::uint16_t>(rng() % 180);
+            e.p = static_cast<std::uint8_t>(rng() & 1);
+        }
+        const int bad = n == 0 ? 0 : static_cast<int>(rng() % 3);  // refused events planted
+        for (int b = 0; b < bad; ++b) {
+            Event& e = ev[rng() % n];
+            switch (rng() % 6) {
+                case 0: e.x = static_cast<std::uint16_t>(240 + rng() % 65296); break;
+                case 1: e.y = static_cast<std::uint16_t>(180 + rng() % 65356); break;
+                case 2: e.p = static_cast<std::uint8_t>(2 + rng() % 254); break;
+                case 3: e.t = -1001 - static_cast<std::int64_t>(rng() % 5); break;
+                case 4: e.t = 1000001 + static_cast<std::int64_t>(rng() % 5); break;
+                default: e.t = static_cast<std::int64_t>(rng()); break;  // any 64-bit time
+            }
+        }
+        for (const EventLimits* l : {&bounded, &open}) {
+            std::size_t want = n;
+            for (std::size_t i = 0; i < n; ++i)
+                if (!l->accepts(ev[i])) {
+                    want = i;
+                    break;
+                }
+            refused += want != n;
+            ++cases;
+            for (const std::string& path : paths)
+                ASSERT_EQ(first_invalid_event_on_path(path, ev, *l), want)
+                    << path << ", " << n << " events, round " << round;
+            EXPECT_EQ(first_invalid_event(ev, *l), want);
+        }
+    }
+    EXPECT_GT(refused, cases / 4);  // both outcomes are exercised
+    EXPECT_LT(refused, cases);
+    EXPECT_THROW((void)first_invalid_event_on_path("no-such-path", {}, open), std::invalid_argument);
+}
+
 // The unchecked forms answer as the checked ones on valid events.
 template <class D>
 void expect_unchecked_same(D a, D b, D c) {

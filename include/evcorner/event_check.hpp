@@ -10,6 +10,9 @@
 #include <limits>
 #include <span>
 #include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "evcorner/event.hpp"
 #include "evcorner/sensor.hpp"
@@ -47,10 +50,17 @@ private:
 };
 
 /// Index of the first event that `limits` does not accept, or events.size() if none.
-/// One tight pass: blocks of events are tested without a branch per event, with AVX2
-/// where the CPU has it (chosen at run time).
+/// One tight pass: blocks of events are tested without a branch per event, with AVX-512
+/// or AVX2 where the CPU has it (chosen at run time).
 [[nodiscard]] std::size_t first_invalid_event(std::span<const Event> events, const EventLimits& limits) noexcept;
 
+/// The passes first_invalid_event() may take on this CPU ("avx512", "avx2", "portable"),
+/// the one it takes first.
+[[nodiscard]] std::vector<std::string> event_check_paths();
+/// first_invalid_event() on a named pass (one of event_check_paths(); else
+/// std::invalid_argument): for tests and benchmarks.
+[[nodiscard]] std::size_t first_invalid_event_on_path(std::string_view path, std::span<const Event> events,
+                                                      const EventLimits& limits);
 /// Throws InvalidEvent unless `limits` accepts `e`.
 inline void check_event(const Event& e, const EventLimits& limits) {
     if (!limits.accepts(e)) [[unlikely]]
