@@ -539,9 +539,23 @@ double Simulator::max_displacement() const noexcept {
 
 Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
     const std::uint64_t tag = key | (static_cast<std::uint64_t>(o) << (kKeyBits + 2));
+    // The instants of the first kDirectBits halvings (most samples: the step's midpoint above
+    // all) are found in a table of their own, indexed by object and key; the others hashed.
+    const bool direct = (key & (kKeyEnd / kDirect - 1)) == 0 && key < kKeyEnd;
+    const std::size_t d = o * kDirect + static_cast<std::size_t>(key / (kKeyEnd / kDirect));
+    if (direct) {
+        if (direct_[d] != 0) return places_[direct_[d] - 1];
+        direct_used_.push_back(static_cast<std::uint32_t>(d));
+        direct_[d] = static_cast<std::uint32_t>(places_n_ + 1);
+        return new_placement(o, key, tag);
+    }
     auto slot_of = [this](std::uint64_t t) {
+        // The top bits of a Fibonacci hash of the tag folded once: the keys are dyadic (their
+        // low bits mostly zero) and the object sits above them, so the product's middle bits,
+        // taken before, put most tags of an instant in one or two slots (long probes).
         const std::size_t mask = slot_tag_.size() - 1;
-        std::size_t i = static_cast<std::size_t>((t * 0x9E3779B97F4A7C15ull) >> 40) & mask;
+        const int shift = 64 - std::countr_zero(slot_tag_.size());
+        std::size_t i = static_cast<std::size_t>(((t ^ (t >> 29)) * 0x9E3779B97F4A7C15ull) >> shift);
         while (slot_tag_[i] != 0 && slot_tag_[i] != t + 1) i = (i + 1) & mask;
         return i;
     };
@@ -562,6 +576,10 @@ Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
     slot_tag_[i] = tag + 1;
     slot_place_[i] = static_cast<std::uint32_t>(places_n_);
     slots_used_.push_back(static_cast<std::uint32_t>(i));
+    return new_placement(o, key, tag);
+}
+
+Simulator::Placement& Simulator::new_placement(std::size_t o, std::uint64_t key, std::uint64_t tag) {
     if (places_.size() <= places_n_) places_.resize(places_n_ + 1);
     Placement& pl = places_[places_n_++];
     pl.tag = tag;
@@ -570,11 +588,10 @@ Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
     return pl;
 }
 
-// On the step's first sample: the pixels each piece can cover within the step (its vertices
-// at both ends, widened by 2 px: a vertex moves less than kMaxMove between them, along a path
-// close to the straight one; an empty rectangle off the sensor), and each tile's pieces.
-void Simulator::make_tiles() {
-    tiles_ready_ = true;
+// On the step's first sample: the pixels each piece can cover within the step: its vertices at both ends, widened by 2 px (a vertex moves less than kMaxMove between
+// them, along a path close to the straight one); an empty rectangle off the sensor.
+void Simulator::make_rects() {
+    rects_ready_ = true;
     piece_rect_.resize(object_first_piece_.back());
     auto to_pixels = [&](double x0, double x1, double y0, double y1) {
         PixelRect r{0, -1, 0, -1};
@@ -592,33 +609,21 @@ void Simulator::make_tiles() {
                     b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
             piece_rect_[object_first_piece_[o] + k] = to_pixels(b.x0, b.x1, b.y0, b.y1);
         }
-    // Each tile's pieces, in order (counted, then placed).
-    tiles_x_ = (w_ + kTile - 1) >> kTileBits;
-    const int tiles_y = (h_ + kTile - 1) >> kTileBits;
-    tile_start_.assign(static_cast<std::size_t>(tiles_x_ * tiles_y) + 1, 0);
-    auto each_tile = [&](const PixelRect& r, auto&& f) {
-        if (r.x1 < r.x0 || r.y1 < r.y0) return;
-        for (int ty = r.y0 >> kTileBits; ty <= r.y1 >> kTileBits; ++ty)
-            for (int tx = r.x0 >> kTileBits; tx <= r.x1 >> kTileBits; ++tx) f(static_cast<std::size_t>(ty * tiles_x_ + tx));
-    };
-    for (const PixelRect& r : piece_rect_) each_tile(r, [&](std::size_t t) { ++tile_start_[t + 1]; });
-    for (std::size_t t = 1; t < tile_start_.size(); ++t) tile_start_[t] += tile_start_[t - 1];
-    tile_items_.resize(tile_start_.back());
-    tile_fill_.assign(tile_start_.begin(), tile_start_.end() - 1);
-    for (std::size_t g = 0; g < piece_rect_.size(); ++g)
-        each_tile(piece_rect_[g], [&](std::size_t t) { tile_items_[tile_fill_[t]++] = static_cast<std::uint32_t>(g); });
 }
 
 void Simulator::near_pieces(std::size_t p, int x, int y) {
-    if (!tiles_ready_) make_tiles();
-    near_.clear();
+    if (!rects_ready_) make_rects();
     near_pixel_ = p;
-    const std::size_t t = static_cast<std::size_t>((y >> kTileBits) * tiles_x_ + (x >> kTileBits));
-    for (std::uint32_t i = tile_start_[t]; i < tile_start_[t + 1]; ++i) {
-        const std::uint32_t g = tile_items_[i];
+    // Every piece, without a jump per piece (which pieces hold a pixel is unpredictable): the
+    // index is written and kept when the pixel is inside (all four differences >= 0).
+    near_.resize(piece_rect_.size());
+    std::size_t n = 0;
+    for (std::size_t g = 0; g < piece_rect_.size(); ++g) {
         const PixelRect& r = piece_rect_[g];
-        if (x >= r.x0 && x <= r.x1 && y >= r.y0 && y <= r.y1) near_.push_back(g);
+        near_[n] = static_cast<std::uint32_t>(g);
+        n += static_cast<std::size_t>(((x - r.x0) | (r.x1 - x) | (y - r.y0) | (r.y1 - y)) >= 0);
     }
+    near_n_ = n;
 }
 
 // The same compositing as render(), for one pixel, with each piece's coverage from its edges
@@ -630,7 +635,7 @@ double Simulator::sample(std::size_t p, std::uint64_t key) {
     const int x = static_cast<int>(p % w), y = static_cast<int>(p / w);
     if (near_pixel_ != p) near_pieces(p, x, y);
     double v = bg_[p];
-    const std::size_t n = near_.size();
+    const std::size_t n = near_n_;
     for (std::size_t i = 0; i < n;) {
         const std::size_t o = piece_object_[near_[i]];
         const Object& obj = scene_.objects[o];
@@ -733,8 +738,11 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     }
     for (const std::uint32_t i : slots_used_) slot_tag_[i] = 0;
     slots_used_.clear();
-    near_pixel_ = SIZE_MAX;  // the pieces move: their rectangles and tiles are made again (make_tiles)
-    tiles_ready_ = false;
+    if (direct_.empty()) direct_.assign(scene_.objects.size() * kDirect, 0);
+    for (const std::uint32_t d : direct_used_) direct_[d] = 0;
+    direct_used_.clear();
+    near_pixel_ = SIZE_MAX;  // the pieces move: their rectangles are made again (make_rects)
+    rects_ready_ = false;
     double worst = 0;
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
     // The dirty pixels (render()'s list, row-major order); those whose value changed go on.

@@ -184,17 +184,14 @@ private:
     std::vector<PixelRect> piece_rect_;        // per piece (global index)
     std::vector<std::uint32_t> piece_object_;  // per piece (global index): its object
     // The pieces (global indices, in order) whose rectangles hold near_pixel_, the pixel being
-    // sampled: found once per pixel and step (near_pieces()), not at every sample of it, among
-    // the pieces whose rectangles meet its tile of kTile x kTile pixels (per step, the tiles'
-    // pieces in order: tile t's are tile_items_[tile_start_[t] .. tile_start_[t + 1])).
-    static constexpr int kTileBits = 4, kTile = 1 << kTileBits;
-    int tiles_x_ = 0;
-    std::vector<std::uint32_t> tile_start_, tile_items_, tile_fill_;
-    bool tiles_ready_ = false;  // made for this step (on its first sample)
-    void make_tiles();
+    // sampled: found once per pixel and step (near_pieces()), not at every sample of it; the
+    // first near_n_ entries of near_.
     std::vector<std::uint32_t> near_;
+    std::size_t near_n_ = 0;
     std::size_t near_pixel_ = SIZE_MAX;
     void near_pieces(std::size_t p, int x, int y);
+    bool rects_ready_ = false;  // piece_rect_ made for this step (on its first sample)
+    void make_rects();
     std::vector<Vec2> placed_;  // the pieces placed at the step's sampled instants
     // Each pixel's value one step before cur_ (hist_), kept when it changed in that step too
     // (hist_step_: that step's index + 1), and the length of the step before this one: with
@@ -209,6 +206,13 @@ private:
     std::size_t places_n_ = 0;
     std::vector<std::uint64_t> slot_tag_;  // open addressing: tag + 1 of the placement (0: empty)
     std::vector<std::uint32_t> slot_place_, slots_used_;
+    // The placements at the first kDirectBits halvings' instants (keys multiple of kKeyEnd /
+    // kDirect): per object and key / (kKeyEnd / kDirect), the placement's index + 1 (0: none
+    // yet this step), and the entries set this step.
+    static constexpr int kDirectBits = 4;
+    static constexpr std::uint64_t kDirect = std::uint64_t{1} << kDirectBits;
+    std::vector<std::uint32_t> direct_, direct_used_;
+    Placement& new_placement(std::size_t o, std::uint64_t key, std::uint64_t tag);
     double step_t0_ = 0, step_len_ = 0, limit_ = 0, crossing_tol_us_ = 0;
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
