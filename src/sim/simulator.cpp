@@ -672,8 +672,21 @@ void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double
         ++split_samples_;
         const std::uint64_t km = ka + (kb - ka) / 2;
         const double m = sample(p, km);
-        refine(p, ka, km, a, m, false, ev);
-        refine(p, km, kb, m, b, false, ev);
+        // A half that crosses is settled when the parabola through a, m, b (at 0, 1, 2 half
+        // lengths) moves its crossing by at most the tolerance (as emit_crossings() does with
+        // a pixel's history): c u (u - 1) is the parabola's departure from the half's line
+        // (the same c for both halves).
+        const double c = 0.5 * ((b - m) - (m - a));
+        const double half_us = 0.5 * (tb - ta);
+        const double on = ion_[p], off = ioff_[p];
+        auto settled_by = [&](double x0, double x1) {
+            const bool up = x1 > x0;
+            if (!(up ? x1 >= on : x1 < x0 && x1 <= off)) return false;  // no crossing: no matter
+            const double u = ((up ? on : off) - x0) / (x1 - x0);
+            return std::abs(c * u * (u - 1.0) / (x1 - x0)) * half_us <= crossing_tol_us_;
+        };
+        refine(p, ka, km, a, m, settled_by(a, m), ev);
+        refine(p, km, kb, m, b, settled_by(m, b), ev);
         return;
     }
     if (crosses && !settled && splittable) {
