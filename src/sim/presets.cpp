@@ -65,7 +65,7 @@ json checkerboard(double x, double y, double sq, int cols, int rows, json motion
 }
 
 // Renders 2.5 ms apart at most (the default is 1 ms): the shapes and polygons move slowly
-// (15-120 px/s), so most of their edge pixels keep the step fraction over 2.5 ms and the few
+// (15-120 px/s), so most of their edge pixels keep the step fraction over 2.5 ms and those
 // that do not are sampled on their own, for less than the renders saved (docs/simulate.md,
 // "Speed"). The busier scenes keep the default: for them the samples would cost more.
 json coarse_steps() {
