@@ -64,11 +64,20 @@ json checkerboard(double x, double y, double sq, int cols, int rows, json motion
             {"motion", std::move(motion)}};
 }
 
+// Renders 2.5 ms apart at most (the default is 1 ms): the shapes and polygons move slowly
+// (15-120 px/s), so most of their edge pixels keep the step fraction over 2.5 ms and those
+// that do not are sampled on their own, for less than the renders saved (docs/simulate.md,
+// "Speed"). The busier scenes keep the default: for them the samples would cost more.
+json coarse_steps() {
+    return {{"max_step_us", 2500}};
+}
+
 json scene_shapes() {
     json j = scene(240, 180, 6.0, 1, "shapes",
                    "four shapes (one not convex) orbiting and spinning at 20-90 px/s over a faint texture",
                    texture(0.5, 0.04, 24));
     j["objects"] = shape_objects(1, 1, nullptr);
+    j["simulation"] = coarse_steps();
     return j;
 }
 
@@ -103,6 +112,7 @@ json scene_polygons() {
                         {"motion", orbit(std::round(w * 10) / 10, 120, 90)}});
     }
     j["objects"] = objs;
+    j["simulation"] = coarse_steps();
     return j;
 }
 

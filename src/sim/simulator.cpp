@@ -26,9 +26,6 @@ constexpr double kSnap = 1e-12;
 // Largest move of any vertex in one step, px (mark_edges needs less than 1).
 constexpr double kMaxMove = 0.75;
 constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
-// A step's instants within it are keys of this many bits (Simulator::key_time).
-constexpr int kKeyBits = 48;
-constexpr std::uint64_t kKeyEnd = std::uint64_t{1} << kKeyBits;
 // A crossing's interpolated time is settled when halving its interval moves it by at most
 // this times step_fraction, us.
 constexpr double kCrossingTolPerFraction = 50.0;
@@ -186,8 +183,9 @@ Simulator::Simulator(Scene scene)
     hist_step_.assign(n, 0);
 
     object_first_piece_.assign(1, 0);
-    for (const Object& obj : scene_.objects) {
-        object_first_piece_.push_back(object_first_piece_.back() + obj.pieces.size());
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
+        object_first_piece_.push_back(object_first_piece_.back() + scene_.objects[o].pieces.size());
+        piece_object_.resize(object_first_piece_.back(), static_cast<std::uint32_t>(o));
     }
     limit_ = scene_.simulation.step_fraction * cam.contrast;
     crossing_tol_us_ = kCrossingTolPerFraction * scene_.simulation.step_fraction;
@@ -539,15 +537,25 @@ double Simulator::max_displacement() const noexcept {
     return worst;
 }
 
-double Simulator::key_time(std::uint64_t key) const noexcept {
-    return key == kKeyEnd ? step_t0_ + step_len_ : step_t0_ + step_len_ * (static_cast<double>(key) * (1.0 / static_cast<double>(kKeyEnd)));
-}
-
 Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
     const std::uint64_t tag = key | (static_cast<std::uint64_t>(o) << (kKeyBits + 2));
+    // The instants of the first kDirectBits halvings (most samples: the step's midpoint above
+    // all) are found in a table of their own, indexed by object and key; the others hashed.
+    const bool direct = (key & (kKeyEnd / kDirect - 1)) == 0 && key < kKeyEnd;
+    const std::size_t d = o * kDirect + static_cast<std::size_t>(key / (kKeyEnd / kDirect));
+    if (direct) {
+        if (direct_[d] != 0) return places_[direct_[d] - 1];
+        direct_used_.push_back(static_cast<std::uint32_t>(d));
+        direct_[d] = static_cast<std::uint32_t>(places_n_ + 1);
+        return new_placement(o, key, tag);
+    }
     auto slot_of = [this](std::uint64_t t) {
+        // The top bits of a Fibonacci hash of the tag folded once: the keys are dyadic (their
+        // low bits mostly zero) and the object sits above them, so the product's middle bits,
+        // taken before, put most tags of an instant in one or two slots (long probes).
         const std::size_t mask = slot_tag_.size() - 1;
-        std::size_t i = static_cast<std::size_t>((t * 0x9E3779B97F4A7C15ull) >> 40) & mask;
+        const int shift = 64 - std::countr_zero(slot_tag_.size());
+        std::size_t i = static_cast<std::size_t>(((t ^ (t >> 29)) * 0x9E3779B97F4A7C15ull) >> shift);
         while (slot_tag_[i] != 0 && slot_tag_[i] != t + 1) i = (i + 1) & mask;
         return i;
     };
@@ -568,6 +576,10 @@ Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
     slot_tag_[i] = tag + 1;
     slot_place_[i] = static_cast<std::uint32_t>(places_n_);
     slots_used_.push_back(static_cast<std::uint32_t>(i));
+    return new_placement(o, key, tag);
+}
+
+Simulator::Placement& Simulator::new_placement(std::size_t o, std::uint64_t key, std::uint64_t tag) {
     if (places_.size() <= places_n_) places_.resize(places_n_ + 1);
     Placement& pl = places_[places_n_++];
     pl.tag = tag;
@@ -576,29 +588,68 @@ Simulator::Placement& Simulator::placement(std::size_t o, std::uint64_t key) {
     return pl;
 }
 
+// On the step's first sample: the pixels each piece can cover within the step: its vertices at both ends, widened by 2 px (a vertex moves less than kMaxMove between
+// them, along a path close to the straight one); an empty rectangle off the sensor.
+void Simulator::make_rects() {
+    rects_ready_ = true;
+    piece_rect_.resize(object_first_piece_.back());
+    auto to_pixels = [&](double x0, double x1, double y0, double y1) {
+        PixelRect r{0, -1, 0, -1};
+        x0 -= 2.0, x1 += 2.0, y0 -= 2.0, y1 += 2.0;
+        if (x1 >= 0 && y1 >= 0 && x0 < w_ && y0 < h_)  // the clamps keep the casts in range
+            r = {static_cast<int>(std::floor(std::max(0.0, x0))), static_cast<int>(std::min(w_ - 1.0, x1)),
+                 static_cast<int>(std::floor(std::max(0.0, y0))), static_cast<int>(std::min(h_ - 1.0, y1))};
+        return r;
+    };
+    for (std::size_t o = 0; o < scene_.objects.size(); ++o)
+        for (std::size_t k = 0; k < polys_[o].size(); ++k) {
+            Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
+            for (const auto* polys : {&prev_polys_[o][k], &polys_[o][k]})
+                for (const Vec2& q : *polys)
+                    b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
+            piece_rect_[object_first_piece_[o] + k] = to_pixels(b.x0, b.x1, b.y0, b.y1);
+        }
+}
+
+void Simulator::near_pieces(std::size_t p, int x, int y) {
+    if (!rects_ready_) make_rects();
+    near_pixel_ = p;
+    // Every piece, without a jump per piece (which pieces hold a pixel is unpredictable): the
+    // index is written and kept when the pixel is inside (all four differences >= 0).
+    near_.resize(piece_rect_.size());
+    std::size_t n = 0;
+    for (std::size_t g = 0; g < piece_rect_.size(); ++g) {
+        const PixelRect& r = piece_rect_[g];
+        near_[n] = static_cast<std::uint32_t>(g);
+        n += static_cast<std::size_t>(((x - r.x0) | (r.x1 - x) | (y - r.y0) | (r.y1 - y)) >= 0);
+    }
+    near_n_ = n;
+}
+
 // The same compositing as render(), for one pixel, with each piece's coverage from its edges
-// (only the pieces that can reach the pixel within the step are placed).
+// (only the pieces that can reach the pixel within the step are placed: near_, an object
+// without any adds nothing).
 double Simulator::sample(std::size_t p, std::uint64_t key) {
     ++stats_.pixel_samples;
     const std::size_t w = static_cast<std::size_t>(w_);
     const int x = static_cast<int>(p % w), y = static_cast<int>(p / w);
-    auto outside = [&](const PixelRect& r) { return x < r.x0 || x > r.x1 || y < r.y0 || y > r.y1; };
+    if (near_pixel_ != p) near_pieces(p, x, y);
     double v = bg_[p];
-    for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
-        if (outside(step_rect_[o])) continue;
+    const std::size_t n = near_n_;
+    for (std::size_t i = 0; i < n;) {
+        const std::size_t o = piece_object_[near_[i]];
         const Object& obj = scene_.objects[o];
         const bool multi = obj.pieces.size() > 1;
-        Placement* pl = nullptr;
+        Placement& pl = placement(o, key);
         double b = 0, s = 0;
-        for (std::size_t k = 0; k < obj.pieces.size(); ++k) {
-            if (outside(piece_rect_[object_first_piece_[o] + k])) continue;
-            if (pl == nullptr) pl = &placement(o, key);
+        for (; i < n && piece_object_[near_[i]] == o; ++i) {
+            const std::size_t k = near_[i] - object_first_piece_[o];
             const std::vector<Vec2>& src = obj.pieces[k].polygon;
-            if (pl->piece_at[k] == kNotPlaced) {
-                pl->piece_at[k] = static_cast<std::uint32_t>(placed_.size());
-                for (const Vec2& q : src) placed_.push_back(pl->pose.apply(q));
+            if (pl.piece_at[k] == kNotPlaced) {
+                pl.piece_at[k] = static_cast<std::uint32_t>(placed_.size());
+                for (const Vec2& q : src) placed_.push_back(pl.pose.apply(q));
             }
-            const double c = pixel_coverage(std::span<const Vec2>(placed_.data() + pl->piece_at[k], src.size()), x, y);
+            const double c = pixel_coverage(std::span<const Vec2>(placed_.data() + pl.piece_at[k], src.size()), x, y);
             b += c;
             if (multi) s += c * obj.pieces[k].intensity;
         }
@@ -621,8 +672,21 @@ void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double
         ++split_samples_;
         const std::uint64_t km = ka + (kb - ka) / 2;
         const double m = sample(p, km);
-        refine(p, ka, km, a, m, false, ev);
-        refine(p, km, kb, m, b, false, ev);
+        // A half that crosses is settled when the parabola through a, m, b (at 0, 1, 2 half
+        // lengths) moves its crossing by at most the tolerance (as emit_crossings() does with
+        // a pixel's history): c u (u - 1) is the parabola's departure from the half's line
+        // (the same c for both halves).
+        const double c = 0.5 * ((b - m) - (m - a));
+        const double half_us = 0.5 * (tb - ta);
+        const double on = ion_[p], off = ioff_[p];
+        auto settled_by = [&](double x0, double x1) {
+            const bool up = x1 > x0;
+            if (!(up ? x1 >= on : x1 < x0 && x1 <= off)) return false;  // no crossing: no matter
+            const double u = ((up ? on : off) - x0) / (x1 - x0);
+            return std::abs(c * u * (u - 1.0) / (x1 - x0)) * half_us <= crossing_tol_us_;
+        };
+        refine(p, ka, km, a, m, settled_by(a, m), ev);
+        refine(p, km, kb, m, b, settled_by(m, b), ev);
         return;
     }
     if (crosses && !settled && splittable) {
@@ -687,31 +751,11 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
     }
     for (const std::uint32_t i : slots_used_) slot_tag_[i] = 0;
     slots_used_.clear();
-    // The pixels each piece (and each object) can cover within the step: its vertices at both
-    // ends, widened by 2 px (a vertex moves less than kMaxMove between them, along a path close
-    // to the straight one); an empty rectangle off the sensor.
-    step_rect_.resize(scene_.objects.size());
-    piece_rect_.resize(object_first_piece_.back());
-    auto to_pixels = [&](double x0, double x1, double y0, double y1) {
-        PixelRect r{0, -1, 0, -1};
-        x0 -= 2.0, x1 += 2.0, y0 -= 2.0, y1 += 2.0;
-        if (x1 >= 0 && y1 >= 0 && x0 < w_ && y0 < h_)  // the clamps keep the casts in range
-            r = {static_cast<int>(std::floor(std::max(0.0, x0))), static_cast<int>(std::min(w_ - 1.0, x1)),
-                 static_cast<int>(std::floor(std::max(0.0, y0))), static_cast<int>(std::min(h_ - 1.0, y1))};
-        return r;
-    };
-    for (std::size_t o = 0; o < scene_.objects.size(); ++o) {
-        Box ob{INFINITY, -INFINITY, INFINITY, -INFINITY};
-        for (std::size_t k = 0; k < polys_[o].size(); ++k) {
-            Box b{INFINITY, -INFINITY, INFINITY, -INFINITY};
-            for (const auto* polys : {&prev_polys_[o][k], &polys_[o][k]})
-                for (const Vec2& q : *polys)
-                    b = {std::min(b.x0, q.x), std::max(b.x1, q.x), std::min(b.y0, q.y), std::max(b.y1, q.y)};
-            piece_rect_[object_first_piece_[o] + k] = to_pixels(b.x0, b.x1, b.y0, b.y1);
-            ob = {std::min(ob.x0, b.x0), std::max(ob.x1, b.x1), std::min(ob.y0, b.y0), std::max(ob.y1, b.y1)};
-        }
-        step_rect_[o] = to_pixels(ob.x0, ob.x1, ob.y0, ob.y1);
-    }
+    if (direct_.empty()) direct_.assign(scene_.objects.size() * kDirect, 0);
+    for (const std::uint32_t d : direct_used_) direct_[d] = 0;
+    direct_used_.clear();
+    near_pixel_ = SIZE_MAX;  // the pieces move: their rectangles are made again (make_rects)
+    rects_ready_ = false;
     double worst = 0;
     const std::uint32_t step_index = static_cast<std::uint32_t>(stats_.steps);
     // The dirty pixels (render()'s list, row-major order); those whose value changed go on.

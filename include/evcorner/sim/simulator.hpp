@@ -114,6 +114,8 @@ private:
     // Per-pixel sampling within a step (multirate): the times of a step [t0, t1] are keys,
     // t0 + (t1 - t0) key / 2^kKeyBits, so that the pixels sampled at the same instant share
     // one placement of the objects.
+    static constexpr int kKeyBits = 48;  // a step's instants are keys of this many bits
+    static constexpr std::uint64_t kKeyEnd = std::uint64_t{1} << kKeyBits;
     struct Box {
         double x0, x1, y0, y1;
     };
@@ -123,7 +125,10 @@ private:
         std::vector<std::uint32_t> piece_at;  // per piece: its vertices' first index in placed_, or kNotPlaced
     };
     static constexpr std::uint32_t kNotPlaced = UINT32_MAX;
-    [[nodiscard]] double key_time(std::uint64_t key) const noexcept;
+    [[nodiscard]] double key_time(std::uint64_t key) const noexcept {
+        return key == kKeyEnd ? step_t0_ + step_len_
+                              : step_t0_ + step_len_ * (static_cast<double>(key) * (1.0 / static_cast<double>(kKeyEnd)));
+    }
     Placement& placement(std::size_t o, std::uint64_t key);
     [[nodiscard]] double sample(std::size_t p, std::uint64_t key);  // pixel p's intensity at the key's time
     // Pixel p from a (at key ka) to b (at kb): splits the interval until its |dL| bound is at
@@ -169,14 +174,24 @@ private:
     std::size_t dirty_n_ = 0;
     std::size_t changed_n_ = 0;  // the dirty pixels whose value changed in the last step (emit_crossings)
     // Per-pixel sampling: each object's first piece in a numbering of every object's pieces in
-    // order (object_first_piece_, plus the end), the pixels each object can cover within the step (step_rect_), the placements of the
-    // current step (a pool reused from step to step) and their index by object and key; the
-    // step being refined and the crossing-time tolerance.
+    // order (object_first_piece_, plus the end), the pixels each piece can cover within the
+    // step (piece_rect_), the placements of the current step (a pool reused from step to step)
+    // and their index by object and key; the step being refined and the crossing-time tolerance.
     std::vector<std::size_t> object_first_piece_;
     struct PixelRect {
         int x0, x1, y0, y1;  // inclusive
     };
-    std::vector<PixelRect> step_rect_, piece_rect_;  // per object, per piece (global index)
+    std::vector<PixelRect> piece_rect_;        // per piece (global index)
+    std::vector<std::uint32_t> piece_object_;  // per piece (global index): its object
+    // The pieces (global indices, in order) whose rectangles hold near_pixel_, the pixel being
+    // sampled: found once per pixel and step (near_pieces()), not at every sample of it; the
+    // first near_n_ entries of near_.
+    std::vector<std::uint32_t> near_;
+    std::size_t near_n_ = 0;
+    std::size_t near_pixel_ = SIZE_MAX;
+    void near_pieces(std::size_t p, int x, int y);
+    bool rects_ready_ = false;  // piece_rect_ made for this step (on its first sample)
+    void make_rects();
     std::vector<Vec2> placed_;  // the pieces placed at the step's sampled instants
     // Each pixel's value one step before cur_ (hist_), kept when it changed in that step too
     // (hist_step_: that step's index + 1), and the length of the step before this one: with
@@ -191,6 +206,13 @@ private:
     std::size_t places_n_ = 0;
     std::vector<std::uint64_t> slot_tag_;  // open addressing: tag + 1 of the placement (0: empty)
     std::vector<std::uint32_t> slot_place_, slots_used_;
+    // The placements at the first kDirectBits halvings' instants (keys multiple of kKeyEnd /
+    // kDirect): per object and key / (kKeyEnd / kDirect), the placement's index + 1 (0: none
+    // yet this step), and the entries set this step.
+    static constexpr int kDirectBits = 4;
+    static constexpr std::uint64_t kDirect = std::uint64_t{1} << kDirectBits;
+    std::vector<std::uint32_t> direct_, direct_used_;
+    Placement& new_placement(std::size_t o, std::uint64_t key, std::uint64_t tag);
     double step_t0_ = 0, step_len_ = 0, limit_ = 0, crossing_tol_us_ = 0;
     // Noise: the next background-activity time and its stream.
     Random noise_rng_;
