@@ -108,6 +108,9 @@ private:
         ArcStarLatest* latest;
         std::ptrdiff_t width;
         int height;
+        // The columns and rows whose circles lie on the sensor: kCircleMargin <= x <
+        // kCircleMargin + inner_width, and so for y (0 on a sensor too small for any).
+        std::uint32_t inner_width, inner_height;
         std::int64_t window;
         bool filter, minority_only, zero_init;
         ArcStarCircles circles;
@@ -117,6 +120,8 @@ private:
                     d.latest_.data(),
                     d.sae_.size().width,
                     d.sae_.size().height,
+                    inner(d.sae_.size().width),
+                    inner(d.sae_.size().height),
                     d.params_.filter_us,
                     d.params_.filter,
                     d.params_.minority_only,
@@ -214,10 +219,14 @@ private:
         bool filter_event(const Event& e) const noexcept {
             return filter_update<Published>(e.p & 1, static_cast<std::ptrdiff_t>(e.y) * width + e.x, Sae::stored(e.t));
         }
-        // Whether e lies off the border (its circles on the sensor).
+        static std::uint32_t inner(int side) noexcept {
+            return static_cast<std::uint32_t>(side > 2 * kCircleMargin ? side - 2 * kCircleMargin : 0);
+        }
+        // Whether e lies off the border (its circles on the sensor): two unsigned compares
+        // (a coordinate below the margin wraps to a large value), not four signed ones.
         bool inside(const Event& e) const noexcept {
-            return !(e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
-                     e.y >= height - kCircleMargin);
+            return (static_cast<std::uint32_t>(e.x - kCircleMargin) < inner_width) &
+                   (static_cast<std::uint32_t>(e.y - kCircleMargin) < inner_height);
         }
 
         // Published: the caller knows filter && !zero_init.
