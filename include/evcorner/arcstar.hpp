@@ -8,7 +8,6 @@
 // event writes the filtered SAE of its polarity; away from the border it is a corner iff
 // the Arc* arc test (arcstar_test.hpp) passes on the radius-3 and then the radius-4 circle.
 
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -179,11 +178,9 @@ private:
             bool pending = false;
             const std::size_t n = events.size();
             bool pass_next = n != 0 && filter_event<Published>(events[0]);
-            // Every flag 0 first (a memset), then only the candidates' written: one load and
-            // one store fewer per event than a flag written in the loop.
-            std::fill(is_corner.begin(), is_corner.end(), std::uint8_t{0});
             for (std::size_t i = 0; i < n; ++i) {
                 const Event& e = events[i];
+                is_corner[i] = 0;
                 const bool pass = pass_next;
                 if (i + 1 < n) pass_next = filter_event<Published>(events[i + 1]);
                 if (!pass) continue;
