@@ -212,18 +212,20 @@ TEST(ArcStarBatch, RadiusFourTestSeesTheSaeOfItsOwnEvent) {
 
 // ---- the AVX-512 test's range across batches
 
-// The AVX-512 test holds a circle as 32-bit times relative to its event, exact while every
-// fired pixel lies within 2^30 - 1 us of the event (checked per circle, else the portable
-// test); a loop that left the check out for batches whose own span is small would be
-// wrong here, as would one off by one at the edge (a variant that decided it per batch
-// from every time the detector took was measured and dropped: docs/arcstar.md). On a 9x9
-// sensor (only the centre is off the border) pixel 0 of the radius-3 circle fires at t = 0
-// in a first batch; pixels 14 and 15 of that circle, an arc of four pixels of the radius-4
-// circle and then the centre fire `last - 6 .. last` in a second. Exactly, pixels 14, 15,
-// 0 form a separating arc of 3 (pixel 0 is newer than the never-fired rest): a corner.
-// Were pixel 0 taken as never fired (a relative time clamped at -2^30), the radius-3 arc
-// would be the whole circle: no corner. With last = 2^30 - 1 pixel 0 is in range; with
-// 2^30 (the clamp's edge) and 2^31 + 5 it is not, though the second batch's own span is.
+// The AVX-512 test holds a circle as 32-bit ages relative to its event, exact while every
+// fired pixel lies at most kRange - kAhead - 1 us before the event (and at most kAhead
+// after it; checked per circle, else the portable test); a loop that left the check out
+// for batches whose own span is small would be wrong here, as would one off by one at the
+// edge (a variant that decided it per batch from every time the detector took was
+// measured and dropped: docs/arcstar.md). On a 9x9 sensor (only the centre is off the
+// border) pixel 0 of the radius-3 circle fires at t = 0 in a first batch; pixels 14 and 15
+// of that circle, an arc of four pixels of the radius-4 circle and then the centre fire
+// `last - 6 .. last` in a second. Exactly, pixels 14, 15, 0 form a separating arc of 3
+// (pixel 0 is newer than the never-fired rest): a corner. Were pixel 0 taken as never
+// fired, or its age wrapped or saturated, the radius-3 arc would be the whole circle: no
+// corner. With last = kRange - kAhead - 1 pixel 0 is in range; with kRange - kAhead,
+// 2^30, 2^31 + 5 and 2^32 + 5 (an age whose low 32 bits are in range) it is not, though
+// the second batch's own span is.
 std::vector<Event> range_edge_stream(std::int64_t last) {
     const auto on = [](const Offset& o, std::int64_t t) {
         return Event{t, static_cast<std::uint16_t>(4 + o.dx), static_cast<std::uint16_t>(4 + o.dy), 1};
@@ -239,7 +241,13 @@ std::vector<Event> range_edge_stream(std::int64_t last) {
 template <class First, class Second>
 void expect_range_edges_exact(const char* path, First first, Second second) {
     const SensorSize size{9, 9};
-    for (const std::int64_t last : {(std::int64_t{1} << 30) - 1, std::int64_t{1} << 30, (std::int64_t{1} << 31) + 5}) {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    constexpr std::int64_t kEdge = ArcStarAvx512::kRange - ArcStarAvx512::kAhead;
+#else
+    constexpr std::int64_t kEdge = (std::int64_t{1} << 30) - (std::int64_t{1} << 20);
+#endif
+    for (const std::int64_t last : {kEdge - 1, kEdge, std::int64_t{1} << 30, (std::int64_t{1} << 31) + 5,
+                                    (std::int64_t{1} << 32) + 5}) {
         const std::vector<Event> events = range_edge_stream(last);
         naive::ArcStarNaive oracle(size);
         std::vector<std::uint8_t> want;

@@ -107,34 +107,34 @@ template <int N, int Lmin, int Lmax>
             const Offset o = N == 16 ? kCircle3[k] : kCircle4[k];
             grid[static_cast<std::size_t>(centre + o.dy * kGrid + o.dx)] = c[k];
         }
-        // The event's stored time: just after the newest pixel (32-bit relative times), or
-        // far away (some or all fired pixels beyond +-2^31: the portable fallback), or at
-        // the edge of the relative range: the oldest fired pixel 2^30 - 1 before the event
-        // (the last time held relative, one above the never-fired value -2^30) and 2^30
-        // before it (the first one that is not: the fallback).
+        // The event's stored time: just after the newest pixel (32-bit ages), or far away
+        // (some or all fired pixels beyond 2^31: the portable fallback), or at the edge of
+        // the narrowed range: the oldest fired pixel kRange - kAhead - 1 before the event
+        // (the oldest age held, kRange - 1, one below the never-fired value kRange) and
+        // kRange - kAhead before it (the first one that is not: the fallback).
         std::int64_t newest = 0, oldest_fired = INT64_MAX;
         for (std::int64_t v : c) {
             newest = std::max(newest, v);
             if (v != 0) oldest_fired = std::min(oldest_fired, v);
         }
-        constexpr std::int64_t kRange = std::int64_t{1} << 30;
+        constexpr std::int64_t kRange = ArcStarAvx512::kRange, kAhead = ArcStarAvx512::kAhead;
         std::vector<std::int64_t> times = {newest + static_cast<std::int64_t>(rng() % 1000),
                                            (std::int64_t{1} << 31) + static_cast<std::int64_t>(rng() % 2000000)};
         if (oldest_fired != INT64_MAX) {
-            times.push_back(oldest_fired + kRange - 1);
-            times.push_back(oldest_fired + kRange);
+            times.push_back(oldest_fired + kRange - kAhead - 1);
+            times.push_back(oldest_fired + kRange - kAhead);
         }
         // And the other edge, an event older than the pixels (unsorted input): the circle
-        // moved up by 2^31 (order unchanged), the newest pixel 2^30 - 1 after the event
-        // (relative) and 2^30 after it (the fallback).
+        // moved up by 2^31 (order unchanged), the newest pixel kAhead after the event (age
+        // 0, in range) and kAhead + 1 after it (the fallback).
         std::array<std::int64_t, kGrid * kGrid> later = grid;
         for (std::int64_t& v : later)
             if (v != 0) v += std::int64_t{1} << 31;
         const std::int64_t later_newest = newest + (std::int64_t{1} << 31);
         const std::size_t n_grid = times.size();
         if (newest != 0) {
-            times.push_back(later_newest - (kRange - 1));
-            times.push_back(later_newest - kRange);
+            times.push_back(later_newest - kAhead);
+            times.push_back(later_newest - kAhead - 1);
         }
         for (bool minority : {false, true}) {
             const bool want = naive::arcstar_arc_naive<N>(c, Lmin, Lmax, minority);

@@ -108,6 +108,9 @@ private:
         ArcStarLatest* latest;
         std::ptrdiff_t width;
         int height;
+        // The columns and rows whose circles lie on the sensor: kCircleMargin <= x <
+        // kCircleMargin + inner_width, and so for y (0 on a sensor too small for any).
+        std::uint32_t inner_width, inner_height;
         std::int64_t window;
         bool filter, minority_only, zero_init;
         ArcStarCircles circles;
@@ -117,6 +120,8 @@ private:
                     d.latest_.data(),
                     d.sae_.size().width,
                     d.sae_.size().height,
+                    inner(d.sae_.size().width),
+                    inner(d.sae_.size().height),
                     d.params_.filter_us,
                     d.params_.filter,
                     d.params_.minority_only,
@@ -150,7 +155,10 @@ private:
         template <class Search, bool Published>
         std::size_t run(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
             if constexpr (kMovedBranches<Search>) {
-                return run_moved<Search, Published>(events, is_corner);
+                // minority_only as a constant too (the published false, or true): the arc
+                // tests' decision then reads no parameter.
+                if (minority_only) return run_moved<Search, Published, true>(events, is_corner);
+                return run_moved<Search, Published, false>(events, is_corner);
             } else {
                 std::size_t corners = 0;
                 for (std::size_t i = 0; i < events.size(); ++i) {
@@ -161,7 +169,7 @@ private:
                 return corners;
             }
         }
-        template <class Search, bool Published>
+        template <class Search, bool Published, bool MinorityOnly>
         std::size_t run_moved(std::span<const Event> events, std::span<std::uint8_t> is_corner) const noexcept {
             std::size_t corners = 0;
             const std::int64_t* cand_centre = nullptr;  // the pending candidate, if any
@@ -180,9 +188,10 @@ private:
                 const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(e.y) * width + e.x;
                 const std::int64_t st = Sae::stored(e.t);
                 std::int64_t* const centre = plane[p] + at;
-                const bool r3 = inside(e) && circles.pass_circle<Search, 16, kArc3Min, kArc3Max>(centre, st, minority_only);
+                const bool r3 =
+                    inside(e) && circles.pass_circle<Search, 16, kArc3Min, kArc3Max>(centre, st, MinorityOnly);
                 if (pending) {
-                    const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max>(cand_centre, cand_st, minority_only);
+                    const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max>(cand_centre, cand_st, MinorityOnly);
                     is_corner[cand] = static_cast<std::uint8_t>(c);
                     corners += c;
                 }
@@ -193,7 +202,7 @@ private:
                 cand = i;
             }
             if (pending) {
-                const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max>(cand_centre, cand_st, minority_only);
+                const bool c = circles.pass_circle<Search, 20, kArc4Min, kArc4Max>(cand_centre, cand_st, MinorityOnly);
                 is_corner[cand] = static_cast<std::uint8_t>(c);
                 corners += c;
             }
@@ -214,10 +223,14 @@ private:
         bool filter_event(const Event& e) const noexcept {
             return filter_update<Published>(e.p & 1, static_cast<std::ptrdiff_t>(e.y) * width + e.x, Sae::stored(e.t));
         }
-        // Whether e lies off the border (its circles on the sensor).
+        static std::uint32_t inner(int side) noexcept {
+            return static_cast<std::uint32_t>(side > 2 * kCircleMargin ? side - 2 * kCircleMargin : 0);
+        }
+        // Whether e lies off the border (its circles on the sensor): two unsigned compares
+        // (a coordinate below the margin wraps to a large value), not four signed ones.
         bool inside(const Event& e) const noexcept {
-            return !(e.x < kCircleMargin || e.x >= width - kCircleMargin || e.y < kCircleMargin ||
-                     e.y >= height - kCircleMargin);
+            return (static_cast<std::uint32_t>(e.x - kCircleMargin) < inner_width) &
+                   (static_cast<std::uint32_t>(e.y - kCircleMargin) < inner_height);
         }
 
         // Published: the caller knows filter && !zero_init.

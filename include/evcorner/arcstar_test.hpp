@@ -268,15 +268,17 @@ template <int N, int Lmin, int Lmax, class Search = ScalarSearch, class Offset>
 /// registers (as eFAST's AVX-512 path, Avx512Search): lane s holds the oldest of the L
 /// pixels from s and the newest of the N-L pixels before s (the rest of that arc), both
 /// grown one pixel per length from rotated copies of the circle; one subtraction per
-/// two lengths (the sign of newest-of-rest minus oldest-of-arc, the rest of the longer
-/// arc against the oldest of the shorter: separation2()) and ORs of the differences.
-/// No serial growth and no data-dependent branch. Only for code compiled for AVX-512.
+/// two lengths (the sign of the oldest-of-arc's age minus the newest-of-rest's, the rest
+/// of the longer arc against the oldest of the shorter: separation2()) and ORs of the
+/// differences. No serial growth and no data-dependent branch. Only for code compiled
+/// for AVX-512.
 ///
-/// The circle is held as 32-bit times relative to the event's (order is all the test
-/// reads): 16 pixels fill one register instead of two. That is exact while every fired
-/// pixel of the circle lies within +-(2^30 - 1) us (17.9 minutes) of the event;
-/// never-fired pixels become -2^30, older than all of them. A circle outside that range
-/// (never on the real files) takes the portable test (arcstar_circle_passes).
+/// The circle is held as 32-bit ages relative to the event's time (order is all the test
+/// reads; older = larger): 16 pixels fill one register instead of two. That is exact
+/// while every fired pixel of the circle lies from 2^30 - 2^20 - 1 us (17.9 minutes)
+/// before the event to 2^20 us after it (relative()); never-fired pixels get the age
+/// 2^30, older than all of them. A circle outside that range (never on the real files)
+/// takes the portable test (arcstar_circle_passes).
 EVCORNER_AVX512_WARNINGS_OFF
 struct ArcStarAvx512 {
     // Values per pixel of a 16-pixel circle: one register of 32-bit lanes.
@@ -322,24 +324,26 @@ struct ArcStarAvx512 {
         return {{Max ? _mm512_max_epi32(a.v[0], b.v[0]) : _mm512_min_epi32(a.v[0], b.v[0]),
                  Max ? _mm512_max_epi32(a.v[1], b.v[1]) : _mm512_min_epi32(a.v[1], b.v[1])}};
     }
+    // The lanes hold ages, not times (relative(): larger = older), so the oldest of a
+    // set of pixels is their maximum and the newest their minimum.
     // The oldest of t[s .. s+L-1] in lane s, one pixel more per length.
     template <int N, int L, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto oldest_from(const C& t) noexcept {
         if constexpr (L == 1) return t.template rot<0>();
-        else return lanes<false>(oldest_from<N, L - 1>(t), t.template rot<L - 1>());
+        else return lanes<true>(oldest_from<N, L - 1>(t), t.template rot<L - 1>());
     }
     // The newest of t[s-M .. s-1] in lane s: the rest of the arc of N-M pixels from s.
     template <int N, int M, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto newest_before(const C& t) noexcept {
         if constexpr (M == 1) return t.template rot<N - 1>();
-        else return lanes<true>(newest_before<N, M - 1>(t), t.template rot<N - M>());
+        else return lanes<false>(newest_before<N, M - 1>(t), t.template rot<N - M>());
     }
     // Lane s of the result has its sign bit set iff the arc of L pixels from s is
-    // separating: (newest of the rest) - (oldest of the arc) < 0. The times are within
-    // +-2^30 (relative()), so the difference does not overflow. A difference and an OR
-    // per length rather than a compare into a mask register and a mask OR: the mask
-    // instructions were the bottleneck (radius 4: 38 -> 27 ns per test in a loop of
-    // tests on this machine).
+    // separating: (age of the arc's oldest) - (age of the rest's newest) < 0. The ages
+    // lie within [0, 2^30] (relative()), so the difference does not overflow. A
+    // difference and an OR per length rather than a compare into a mask register and a
+    // mask OR: the mask instructions were the bottleneck (radius 4: 38 -> 27 ns per test
+    // in a loop of tests on this machine).
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static Lanes16 minus(const Lanes16& r, const Lanes16& o) noexcept {
         return {_mm512_sub_epi32(r.v, o.v)};
     }
@@ -371,17 +375,18 @@ struct ArcStarAvx512 {
     }
     template <int N, int L, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto separation(const C& t) noexcept {
-        return minus(newest_before<N, N - L>(t), oldest_from<N, L>(t));
+        return minus(oldest_from<N, L>(t), newest_before<N, N - L>(t));
     }
     // Sign bit set in lane s iff the arc of L or the arc of L + 1 pixels from s is
-    // separating: (newest of the N - L - 1 pixels before s) - (oldest of the L from s) < 0.
+    // separating: the oldest of the L from s is newer than the newest of the N - L - 1
+    // pixels before s.
     // (If t[s+L] is older than the L-arc's oldest, the L-arc's rest is older than it too;
     // else the (L+1)-arc has the same oldest and the shorter rest. The converse: the
     // L-arc's oldest is at least the (L+1)-arc's, its rest at least the (L+1)-arc's rest.)
     // One subtraction per two lengths (efast_avx512.hpp uses the same pairing).
     template <int N, int L, class C>
     [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline auto separation2(const C& t) noexcept {
-        return minus(newest_before<N, N - L - 1>(t), oldest_from<N, L>(t));
+        return minus(oldest_from<N, L>(t), newest_before<N, N - L - 1>(t));
     }
     // Sign bit set in lane s iff some arc of a length in L..Hi (L <= Hi) from s is
     // separating. (The recursions repeat sub-expressions; the intrinsics are pure, so the
@@ -406,18 +411,35 @@ struct ArcStarAvx512 {
         return minority | (!minority_only & !between & majority);
     }
 
-    // 8 stored times as 32-bit times relative to `st`, and the lanes where that is not
-    // exact (a fired pixel more than 2^30 - 1 us away): saturating narrowing, then a
-    // never-fired pixel (stored 0) becomes -2^30, older than every time in range; within
-    // +-2^30 the differences of separation() do not overflow.
-    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i relative(__m512i q, __m512i st,
+    // The narrowed range: a fired pixel's age a = (st + kAhead) - q (st the event's stored
+    // time, q the pixel's) is exact in 32 bits for a in [0, kRange), that is, for a pixel
+    // fired at most kRange - kAhead - 1 us before the event (17.9 minutes) or at most
+    // kAhead us after it (1.05 s; only a stream out of time order has such pixels). A
+    // never-fired pixel gets the age kRange, older than every fired one in range.
+    static constexpr std::int64_t kRange = std::int64_t{1} << 30;
+    static constexpr std::int64_t kAhead = std::int64_t{1} << 20;
+    // `st + kAhead` broadcast, for relative().
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m512i origin(std::int64_t st) noexcept {
+        // In unsigned arithmetic: st + kAhead may wrap (st near INT64_MAX); relative()
+        // computes modulo 2^64 and is exact all the same.
+        return _mm512_set1_epi64(static_cast<std::int64_t>(static_cast<std::uint64_t>(st) + kAhead));
+    }
+    // An octet of stored times q as 32-bit ages from `o` (origin()), and in `inexact` the
+    // lanes of fired pixels whose age is not in [0, kRange). Four instructions: the
+    // subtraction, two vptestmq (fired; age outside the range, for fired lanes only) and
+    // the narrowing, which writes kRange into the never-fired lanes. The ages are
+    // computed modulo 2^64: st - q lies within (-2^63, 2^63), so the range [kAhead -
+    // 2^63, kAhead + 2^63) of the true age holds one representative of each residue, and
+    // a residue in [0, kRange) is the true age. (Ages, older = larger, rather than times
+    // minus a base: a never-fired pixel must take the oldest value, and with ages that is
+    // a merge constant of the narrowing, where with times it needed a vpmaxsd clamp and
+    // a two-sided range check.)
+    [[gnu::target(EVCORNER_AVX512_TARGET)]] static inline __m256i relative(__m512i q, __m512i o,
                                                                         __mmask8& inexact) noexcept {
-        constexpr std::int64_t kRange = std::int64_t{1} << 30;
-        const __m512i d = _mm512_sub_epi64(q, st);
-        // d within [-kRange + 1, kRange - 1]  <=>  unsigned(d - (-kRange + 1)) <= 2 kRange - 2
-        const __m512i u = _mm512_sub_epi64(d, _mm512_set1_epi64(-kRange + 1));
-        inexact |= _mm512_mask_cmpgt_epu64_mask(_mm512_test_epi64_mask(q, q), u, _mm512_set1_epi64(2 * kRange - 2));
-        return _mm256_max_epi32(_mm512_cvtsepi64_epi32(d), _mm256_set1_epi32(-static_cast<std::int32_t>(kRange)));
+        const __m512i age = _mm512_sub_epi64(o, q);
+        const __mmask8 fired = _mm512_test_epi64_mask(q, q);
+        inexact = _mm512_mask_test_epi64_mask(fired, age, _mm512_set1_epi64(~(kRange - 1)));
+        return _mm512_mask_cvtsepi64_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(kRange)), fired, age);
     }
 
     // The circles' pixels are loaded by rows, as eFAST's AVX-512 path does
@@ -456,10 +478,10 @@ struct ArcStarAvx512 {
         const efast_avx512::Rows<3> r(centre, stride, 3 * stride);
         const __m256i q0 = efast_avx512::quad<kCircle3, 0>(r), q1 = efast_avx512::quad<kCircle3, 4>(r);
         const __m256i q2 = efast_avx512::quad<kCircle3, 8>(r), q3 = efast_avx512::quad<kCircle3, 12>(r);
-        const __m512i vst = _mm512_set1_epi64(st);
-        __mmask8 inexact = 0;
-        const __m256i lo = relative(octet(q0, q1), vst, inexact), hi = relative(octet(q2, q3), vst, inexact);
-        if (inexact != 0) [[unlikely]]
+        const __m512i o = origin(st);
+        __mmask8 inexact0, inexact1;
+        const __m256i lo = relative(octet(q0, q1), o, inexact0), hi = relative(octet(q2, q3), o, inexact1);
+        if (!_kortestz_mask8_u8(inexact0, inexact1)) [[unlikely]]  // one kortestb
             return portable_fallback<N, Lmin, Lmax, kCircle3>(centre, w, minority_only);
         return passes<N, Lmin, Lmax>(Circle16{octet(lo, hi)}, minority_only);
     }
@@ -474,10 +496,10 @@ struct ArcStarAvx512 {
         const __m256i q2 = efast_avx512::quad<kCircle4, 8>(r), q3 = efast_avx512::quad<kCircle4, 12>(r);
         const __m256i q4 = efast_avx512::quad<kCircle4, 16>(r);
         const __m512i w0 = octet(q0, q1), w1 = octet(q2, q3), w2 = octet(q4, q0);
-        const __m512i vst = _mm512_set1_epi64(st);
-        __mmask8 inexact = 0;
-        const __m256i a = relative(w0, vst, inexact), b = relative(w1, vst, inexact), c = relative(w2, vst, inexact);
-        if (inexact != 0) [[unlikely]]
+        const __m512i o = origin(st);
+        __mmask8 inexact0, inexact1, inexact2;
+        const __m256i a = relative(w0, o, inexact0), b = relative(w1, o, inexact1), c = relative(w2, o, inexact2);
+        if (!_kortestz_mask8_u8(_kor_mask8(inexact0, inexact1), inexact2)) [[unlikely]]
             return portable_fallback<N, Lmin, Lmax, kCircle4>(centre, w, minority_only);
         const __m512i v0 = octet(a, b);  // t[0..16)
         // t[16..20) into lanes 12..15, then t[16..20) t[0..12) and t[12..20) t[0..8).
