@@ -61,21 +61,15 @@ ScoredLoop scored_loop_of(Loop loop) noexcept {
     return scored_portable;
 }
 
-struct Path {
-    const char* name;
-    Loop loop;
-};
+using Path = CodePath<Loop>;
 
 // The paths this CPU runs, fastest first.
 std::vector<Path> available() {
-    std::vector<Path> paths;
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-    if (cpu_runs_avx512())
-        paths.push_back({"avx512", detect_avx512});
-    if (cpu_runs_avx2()) paths.push_back({"avx2", detect_avx2});
+    return runnable_paths<Loop>(detect_avx512, detect_avx2, detect_portable);
+#else
+    return runnable_paths<Loop>(nullptr, nullptr, detect_portable);
 #endif
-    paths.push_back({"portable", detect_portable});
-    return paths;
 }
 
 const std::vector<Path>& paths() {
@@ -94,11 +88,11 @@ const Path& choice() noexcept {
 std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
     detail::check_flags(events.size(), is_corner.size(), "detect");
     check_events(events, det.limits());  // one pass over the batch, before the first event
-    return choice().loop(det, events, is_corner);
+    return choice().fn(det, events, is_corner);
 }
 
 std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-    return choice().loop(det, events, is_corner);
+    return choice().fn(det, events, is_corner);
 }
 
 std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
@@ -106,12 +100,12 @@ std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uin
     detail::check_flags(events.size(), is_corner.size(), "detect");
     detail::check_flags(events.size(), score.size(), "detect (scores)");
     check_events(events, det.limits());
-    return scored_loop_of(choice().loop)(det, events, is_corner, score);
+    return scored_loop_of(choice().fn)(det, events, is_corner, score);
 }
 
 std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
                              std::span<double> score) noexcept {
-    return scored_loop_of(choice().loop)(det, events, is_corner, score);
+    return scored_loop_of(choice().fn)(det, events, is_corner, score);
 }
 
 const char* efast_code_path() noexcept { return choice().name; }
@@ -128,7 +122,7 @@ std::size_t detect_on_path(std::string_view path, EFast& det, std::span<const Ev
         if (path == p.name) {
             detail::check_flags(events.size(), is_corner.size(), "detect_on_path");
             check_events(events, det.limits());
-            return p.loop(det, events, is_corner);
+            return p.fn(det, events, is_corner);
         }
     throw std::invalid_argument("eFAST code path '" + std::string(path) + "' does not run on this CPU");
 }

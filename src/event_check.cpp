@@ -147,44 +147,37 @@ EVCORNER_AVX512_WARNINGS_ON
 }
 #endif
 
-struct FinderPath {
-    const char* name;
-    Finder finder;
-};
-
 // The passes this CPU runs, fastest first.
-std::vector<FinderPath> finder_paths() {
-    std::vector<FinderPath> paths;
+std::vector<CodePath<Finder>> finder_paths() {
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-    if (cpu_runs_avx512()) paths.push_back({"avx512", first_invalid_avx512});
-    if (cpu_runs_avx2()) paths.push_back({"avx2", first_invalid_avx2});
+    return runnable_paths<Finder>(first_invalid_avx512, first_invalid_avx2, first_invalid<all_accepted>);
+#else
+    return runnable_paths<Finder>(nullptr, nullptr, first_invalid<all_accepted>);
 #endif
-    paths.push_back({"portable", first_invalid<all_accepted>});
-    return paths;
 }
 
-const std::vector<FinderPath>& finders() {
-    static const std::vector<FinderPath> p = finder_paths();
+const std::vector<CodePath<Finder>>& finders() {
+    static const std::vector<CodePath<Finder>> p = finder_paths();
     return p;
 }
 
 }  // namespace
 
 std::size_t first_invalid_event(std::span<const Event> events, const EventLimits& limits) noexcept {
-    static const Finder finder = finders().front().finder;
+    static const Finder finder = finders().front().fn;
     return finder(events, limits);
 }
 
 std::vector<std::string> event_check_paths() {
     std::vector<std::string> names;
-    for (const FinderPath& p : finders()) names.emplace_back(p.name);
+    for (const CodePath<Finder>& p : finders()) names.emplace_back(p.name);
     return names;
 }
 
 std::size_t first_invalid_event_on_path(std::string_view path, std::span<const Event> events,
                                         const EventLimits& limits) {
-    for (const FinderPath& p : finders())
-        if (path == p.name) return p.finder(events, limits);
+    for (const CodePath<Finder>& p : finders())
+        if (path == p.name) return p.fn(events, limits);
     throw std::invalid_argument("event check path '" + std::string(path) + "' does not run on this CPU");
 }
 

@@ -51,6 +51,27 @@ inline bool cpu_runs_avx2() noexcept {
 #endif
 }
 
+/// A code path of a loop compiled several times: its name ("avx512", "avx2", "portable")
+/// and its entry point.
+template <class Fn>
+struct CodePath {
+    const char* name;
+    Fn fn;
+};
+
+/// The paths of a loop this CPU runs, fastest first: `avx512` and `avx2` where the CPU
+/// runs them (and the build has them), `portable` always.
+template <class Fn>
+std::vector<CodePath<Fn>> runnable_paths([[maybe_unused]] Fn avx512, [[maybe_unused]] Fn avx2, Fn portable) {
+    std::vector<CodePath<Fn>> paths;
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+    if (cpu_runs_avx512()) paths.push_back({"avx512", avx512});
+    if (cpu_runs_avx2()) paths.push_back({"avx2", avx2});
+#endif
+    paths.push_back({"portable", portable});
+    return paths;
+}
+
 /// The path that environment variable `env` names (EVCORNER_EFAST_PATH=portable, ...) among
 /// `paths`, those this CPU runs, fastest first, each with a `name`; the fastest when `env`
 /// is unset or names none of them.
