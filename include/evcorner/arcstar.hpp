@@ -108,9 +108,7 @@ private:
         ArcStarLatest* latest;
         std::ptrdiff_t width;
         int height;
-        // The columns and rows whose circles lie on the sensor: kCircleMargin <= x <
-        // kCircleMargin + inner_width, and so for y (0 on a sensor too small for any).
-        std::uint32_t inner_width, inner_height;
+        InnerRegion inner;  // the events whose circles lie on the sensor
         std::int64_t window;
         bool filter, minority_only, zero_init;
         ArcStarCircles circles;
@@ -120,8 +118,7 @@ private:
                     d.latest_.data(),
                     d.sae_.size().width,
                     d.sae_.size().height,
-                    inner(d.sae_.size().width),
-                    inner(d.sae_.size().height),
+                    InnerRegion::of(d.sae_.size().width, d.sae_.size().height),
                     d.params_.filter_us,
                     d.params_.filter,
                     d.params_.minority_only,
@@ -223,15 +220,8 @@ private:
         bool filter_event(const Event& e) const noexcept {
             return filter_update<Published>(e.p & 1, static_cast<std::ptrdiff_t>(e.y) * width + e.x, Sae::stored(e.t));
         }
-        static std::uint32_t inner(int side) noexcept {
-            return static_cast<std::uint32_t>(side > 2 * kCircleMargin ? side - 2 * kCircleMargin : 0);
-        }
-        // Whether e lies off the border (its circles on the sensor): two unsigned compares
-        // (a coordinate below the margin wraps to a large value), not four signed ones.
-        bool inside(const Event& e) const noexcept {
-            return (static_cast<std::uint32_t>(e.x - kCircleMargin) < inner_width) &
-                   (static_cast<std::uint32_t>(e.y - kCircleMargin) < inner_height);
-        }
+        // Whether e lies off the border (its circles on the sensor).
+        bool inside(const Event& e) const noexcept { return inner.holds(e.x, e.y); }
 
         // Published: the caller knows filter && !zero_init.
         template <class Search, bool Published = false>

@@ -132,9 +132,7 @@ private:
     struct View {
         std::int64_t* plane[2];
         std::ptrdiff_t width;
-        // The columns and rows whose circles lie on the sensor, counted from the margin
-        // (0 on a sensor too small for any): one unsigned compare per coordinate.
-        std::uint32_t inner_width, inner_height;
+        InnerRegion inner;  // the events whose circles lie on the sensor
         // Circle offsets: the AVX-512 path loads the circles through them (filled for it
         // only, so that a single process() does not pay for them).
         std::int64_t off3[16];
@@ -146,8 +144,7 @@ private:
             v.plane[0] = sae.plane(0);
             v.plane[1] = sae.plane(1);
             v.width = sae.size().width;
-            v.inner_width = static_cast<std::uint32_t>(std::max<std::ptrdiff_t>(v.width - 2 * kCircleMargin, 0));
-            v.inner_height = static_cast<std::uint32_t>(std::max(sae.size().height - 2 * kCircleMargin, 0));
+            v.inner = InnerRegion::of(sae.size().width, sae.size().height);
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
             if constexpr (std::is_same_v<Search, Avx512Search>) {
                 for (int k = 0; k < 16; ++k) v.off3[k] = kCircle3[k].dy * v.width + kCircle3[k].dx;
@@ -162,11 +159,7 @@ private:
             std::int64_t* const centre = plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x;
             const std::int64_t st = Sae::stored(e.t);
             *centre = st;  // the SAE update, border events included
-            // Off the border: kCircleMargin <= x < width - kCircleMargin, and so for y (a
-            // coordinate below the margin wraps to a large unsigned value).
-            if ((static_cast<std::uint32_t>(e.x - kCircleMargin) >= inner_width) |
-                (static_cast<std::uint32_t>(e.y - kCircleMargin) >= inner_height))
-                return false;
+            if (!inner.holds(e.x, e.y)) return false;  // a border event
             // Offsets from compile-time circle coordinates: the loads address rows
             // centre + dy * width with constant column offsets.
             const std::ptrdiff_t w = width;
