@@ -29,6 +29,14 @@ constexpr std::uint64_t kSaltThresholds = 1, kSaltNoise = 2, kSaltHot = 3;
 // A crossing's interpolated time is settled when halving its interval moves it by at most
 // this times step_fraction, us.
 constexpr double kCrossingTolPerFraction = 50.0;
+
+// How far the crossing of `level` on the line from x0 to x1 (over len_us) moves when the
+// value bends from that line by c u (u - 1) (u the crossing's place on it, 0 .. 1).
+double bend_shift_us(double c, double x0, double x1, double level, double len_us) noexcept {
+    const double u = (level - x0) / (x1 - x0);
+    return std::abs(c * u * (u - 1.0) / (x1 - x0)) * len_us;
+}
+
 // The next step is shortened when the samples that keep the step fraction exceed this share of
 // the pixels a render recomputes (a sample costs several times a rendered pixel).
 constexpr double kSplitShare = 0.2;
@@ -588,8 +596,9 @@ Simulator::Placement& Simulator::new_placement(std::size_t o, std::uint64_t key,
     return pl;
 }
 
-// On the step's first sample: the pixels each piece can cover within the step: its vertices at both ends, widened by 2 px (a vertex moves less than kMaxMove between
-// them, along a path close to the straight one); an empty rectangle off the sensor.
+// On the step's first sample: the pixels each piece can cover within the step: its
+// vertices at both ends, widened by 2 px (a vertex moves less than kMaxMove between them,
+// along a path close to the straight one); an empty rectangle off the sensor.
 void Simulator::make_rects() {
     rects_ready_ = true;
     piece_rect_.resize(object_first_piece_.back());
@@ -666,7 +675,7 @@ void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double
     const double ta = key_time(ka), tb = key_time(kb);
     const double q = std::abs(a - b) / (kLogEps + std::min(a, b));
     const bool splittable = tb - ta > scene_.simulation.min_step_us && kb - ka >= 2;
-    const bool crosses = b > a ? b >= ion_[p] : b < a && b <= ioff_[p];
+    const bool crosses = reaches_level(p, a, b);
     if (splittable && q > limit_) {
         // Halved: each part checked again.
         ++split_samples_;
@@ -678,12 +687,12 @@ void Simulator::refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double
         // (the same c for both halves).
         const double c = 0.5 * ((b - m) - (m - a));
         const double half_us = 0.5 * (tb - ta);
+        // (Both halves judged against the levels as they stand before the first half's
+        // crossings move them.)
         const double on = ion_[p], off = ioff_[p];
         auto settled_by = [&](double x0, double x1) {
-            const bool up = x1 > x0;
-            if (!(up ? x1 >= on : x1 < x0 && x1 <= off)) return false;  // no crossing: no matter
-            const double u = ((up ? on : off) - x0) / (x1 - x0);
-            return std::abs(c * u * (u - 1.0) / (x1 - x0)) * half_us <= crossing_tol_us_;
+            if (!reaches(x0, x1, on, off)) return false;  // no crossing: no matter
+            return bend_shift_us(c, x0, x1, x1 > x0 ? on : off, half_us) <= crossing_tol_us_;
         };
         refine(p, ka, km, a, m, settled_by(a, m), ev);
         refine(p, km, kb, m, b, settled_by(m, b), ev);
@@ -790,13 +799,11 @@ void Simulator::emit_crossings(double t0, double t1, std::vector<Event>& ev) {
         // starts to change in this step (an edge enters it: a kink) is always sampled.
         if (had_history) {
             const double level = b > a ? ion_[p] : ioff_[p];
-            const double u = (level - a) / (b - a);  // the crossing's place in the step, 0 .. 1
             const double r = last_len_ / step_len_;  // the step before, in units of this one
             // Newton form through (-r, h), (0, a), (1, b): the parabola's departure from the
-            // line through (0, a) and (1, b) at u is c u (u - 1).
+            // line through (0, a) and (1, b) at the crossing's place u is c u (u - 1).
             const double c = ((b - a) - (a - h) / r) / (1.0 + r);
-            const double shift = std::abs(c * u * (u - 1.0) / (b - a)) * step_len_;
-            if (shift <= crossing_tol_us_) {
+            if (bend_shift_us(c, a, b, level, step_len_) <= crossing_tol_us_) {
                 cross(p, t0, t1, a, b, ev);
                 return;
             }

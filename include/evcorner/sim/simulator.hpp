@@ -136,6 +136,14 @@ private:
     void refine(std::size_t p, std::uint64_t ka, std::uint64_t kb, double a, double b, bool settled,
                 std::vector<Event>& ev);
     void cross(std::size_t p, double ta, double tb, double a, double b, std::vector<Event>& ev);
+    // Whether a value going from a to b reaches `on` (rising) or `off` (falling); for pixel
+    // p, its next levels ion_[p] and ioff_[p].
+    [[nodiscard]] static bool reaches(double a, double b, double on, double off) noexcept {
+        return b > a ? b >= on : b < a && b <= off;
+    }
+    [[nodiscard]] bool reaches_level(std::size_t p, double a, double b) const noexcept {
+        return reaches(a, b, ion_[p], ioff_[p]);
+    }
     void emit_noise(double t1, std::vector<Event>& step_events);
     [[nodiscard]] std::uint64_t* row_bits(std::vector<std::uint64_t>& bits, int y) noexcept {
         return bits.data() + static_cast<std::size_t>(y) * words_;
