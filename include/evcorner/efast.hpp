@@ -128,7 +128,7 @@ public:
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
 
 private:
-    // The per-event path on plain values: planes, width, the inner width and height.
+    // The per-event path on plain values: planes, width, the inner region.
     struct View {
         std::int64_t* plane[2];
         std::ptrdiff_t width;
