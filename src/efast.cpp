@@ -16,24 +16,27 @@ namespace evcorner {
 
 namespace {
 
-std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-    return det.run_unchecked<ScalarSearch>(events, is_corner);
+std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                            const TimeSpan& span) noexcept {
+    return det.run_unchecked<ScalarSearch>(events, is_corner, span);
 }
 
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
 // flatten: every call inside is inlined, so the whole per-event path is compiled for
 // AVX2 here and nowhere else (no AVX2 copy of a shared inline function can leak).
 [[gnu::target("avx2"), gnu::flatten]] std::size_t detect_avx2(EFast& det, std::span<const Event> events,
-                                                               std::span<std::uint8_t> is_corner) noexcept {
-    return det.run_unchecked<Avx2Search>(events, is_corner);
+                                                               std::span<std::uint8_t> is_corner,
+                                                               const TimeSpan& span) noexcept {
+    return det.run_unchecked<Avx2Search>(events, is_corner, span);
 }
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t detect_avx512(
-    EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-    return det.run_unchecked<Avx512Search>(events, is_corner);
+    EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner, const TimeSpan& span) noexcept {
+    return det.run_unchecked<Avx512Search>(events, is_corner, span);
 }
 #endif
 
-using Loop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
+// `span`: the batch's time span, or TimeSpan::unknown() (EFast::run_unchecked()).
+using Loop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>, const TimeSpan&) noexcept;
 
 // The scored loops (detect with scores), one per path, beside the binary ones.
 using ScoredLoop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>, std::span<double>) noexcept;
@@ -87,12 +90,13 @@ const Path& choice() noexcept {
 
 std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
     detail::check_flags(events.size(), is_corner.size(), "detect");
-    check_events(events, det.limits());  // one pass over the batch, before the first event
-    return choice().fn(det, events, is_corner);
+    // One pass over the batch, before the first event; it also finds the batch's span.
+    const TimeSpan span = check_events_span(events, det.limits());
+    return choice().fn(det, events, is_corner, span);
 }
 
 std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-    return choice().fn(det, events, is_corner);
+    return choice().fn(det, events, is_corner, TimeSpan::unknown());
 }
 
 std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
@@ -121,8 +125,8 @@ std::size_t detect_on_path(std::string_view path, EFast& det, std::span<const Ev
     for (const Path& p : paths())
         if (path == p.name) {
             detail::check_flags(events.size(), is_corner.size(), "detect_on_path");
-            check_events(events, det.limits());
-            return p.fn(det, events, is_corner);
+            const TimeSpan span = check_events_span(events, det.limits());
+            return p.fn(det, events, is_corner, span);
         }
     throw std::invalid_argument("eFAST code path '" + std::string(path) + "' does not run on this CPU");
 }

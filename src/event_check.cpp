@@ -43,10 +43,12 @@ namespace {
 // Whether all of ev[0, n) are accepted: maxima and minima over the block (branch-free
 // reductions that the compiler vectorises; the 64-bit time ones only where the target
 // has 64-bit vector compares, AVX2, and only when the limits restrict the time).
-inline bool all_accepted(const Event* ev, std::size_t n, const EventLimits& l) noexcept {
+// `span`, when given, is widened by the block's times.
+inline bool all_accepted(const Event* ev, std::size_t n, const EventLimits& l, TimeSpan* span) noexcept {
     std::uint16_t max_x = 0, max_y = 0;
     std::uint8_t max_p = 0;
-    if (l.t_min == std::numeric_limits<std::int64_t>::min() && l.t_max == std::numeric_limits<std::int64_t>::max()) {
+    if (span == nullptr && l.t_min == std::numeric_limits<std::int64_t>::min() &&
+        l.t_max == std::numeric_limits<std::int64_t>::max()) {
         for (std::size_t i = 0; i < n; ++i) {
             max_x = ev[i].x > max_x ? ev[i].x : max_x;
             max_y = ev[i].y > max_y ? ev[i].y : max_y;
@@ -62,25 +64,26 @@ inline bool all_accepted(const Event* ev, std::size_t n, const EventLimits& l) n
         min_t = ev[i].t < min_t ? ev[i].t : min_t;
         max_t = ev[i].t > max_t ? ev[i].t : max_t;
     }
+    if (span != nullptr) *span = span->with({min_t, max_t});
     return n == 0 || (l.accepts(Event{min_t, max_x, max_y, max_p}) && l.accepts(Event{max_t, max_x, max_y, max_p}));
 }
 
 // Blocks of events, each tested by Accepted (all_accepted() or all_accepted_avx512());
 // in the first block that fails, the first failing event.
-template <bool (*Accepted)(const Event*, std::size_t, const EventLimits&) noexcept>
-std::size_t first_invalid(std::span<const Event> events, const EventLimits& limits) noexcept {
+template <bool (*Accepted)(const Event*, std::size_t, const EventLimits&, TimeSpan*) noexcept>
+std::size_t first_invalid(std::span<const Event> events, const EventLimits& limits, TimeSpan* span) noexcept {
     constexpr std::size_t kBlock = 1024;
     const std::size_t n = events.size();
     for (std::size_t at = 0; at < n; at += kBlock) {
         const std::size_t m = n - at < kBlock ? n - at : kBlock;
-        if (!Accepted(events.data() + at, m, limits)) [[unlikely]]
+        if (!Accepted(events.data() + at, m, limits, span)) [[unlikely]]
             for (std::size_t i = at; i < at + m; ++i)
                 if (!limits.accepts(events[i])) return i;
     }
     return n;
 }
 
-using Finder = std::size_t (*)(std::span<const Event>, const EventLimits&) noexcept;
+using Finder = std::size_t (*)(std::span<const Event>, const EventLimits&, TimeSpan*) noexcept;
 
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
 // The AVX-512 pass: four events per 512-bit load (an event is 16 bytes: t in the even
@@ -92,7 +95,7 @@ using Finder = std::size_t (*)(std::span<const Event>, const EventLimits&) noexc
 // takes about 1.3 (issue 14: the check runs before every checked detect()).
 EVCORNER_AVX512_WARNINGS_OFF
 [[gnu::target(EVCORNER_AVX512_TARGET)]] bool all_accepted_avx512(const Event* ev, std::size_t n,
-                                                                 const EventLimits& l) noexcept {
+                                                                 const EventLimits& l, TimeSpan* span) noexcept {
     static_assert(sizeof(Event) == 16 && offsetof(Event, t) == 0 && offsetof(Event, x) == 8 &&
                   offsetof(Event, y) == 10 && offsetof(Event, p) == 12);
     constexpr __mmask8 kTimes = 0x55;  // the even 64-bit lanes: t of each event
@@ -131,6 +134,7 @@ EVCORNER_AVX512_WARNINGS_OFF
     }
     const std::int64_t min_t = _mm512_mask_reduce_min_epi64(kTimes, tmin);
     const std::int64_t max_t = _mm512_mask_reduce_max_epi64(kTimes, tmax);
+    if (span != nullptr) *span = span->with({min_t, max_t});
     // or_p <= 1 iff every p <= 1.
     return l.accepts(Event{min_t, max_x, max_y, or_p}) && l.accepts(Event{max_t, max_x, max_y, or_p});
 }
@@ -138,12 +142,14 @@ EVCORNER_AVX512_WARNINGS_ON
 
 // flatten: the whole pass compiled for AVX2 here and nowhere else.
 [[gnu::target("avx2"), gnu::flatten]] std::size_t first_invalid_avx2(std::span<const Event> events,
-                                                                      const EventLimits& limits) noexcept {
-    return first_invalid<all_accepted>(events, limits);
+                                                                      const EventLimits& limits,
+                                                                      TimeSpan* span) noexcept {
+    return first_invalid<all_accepted>(events, limits, span);
 }
 [[gnu::target(EVCORNER_AVX512_TARGET)]] std::size_t first_invalid_avx512(std::span<const Event> events,
-                                                                         const EventLimits& limits) noexcept {
-    return first_invalid<all_accepted_avx512>(events, limits);
+                                                                         const EventLimits& limits,
+                                                                         TimeSpan* span) noexcept {
+    return first_invalid<all_accepted_avx512>(events, limits, span);
 }
 #endif
 
@@ -161,11 +167,20 @@ const std::vector<CodePath<Finder>>& finders() {
     return p;
 }
 
+const Finder& finder() noexcept {
+    static const Finder f = finders().front().fn;
+    return f;
+}
+
 }  // namespace
 
 std::size_t first_invalid_event(std::span<const Event> events, const EventLimits& limits) noexcept {
-    static const Finder finder = finders().front().fn;
-    return finder(events, limits);
+    return finder()(events, limits, nullptr);
+}
+
+std::size_t first_invalid_event(std::span<const Event> events, const EventLimits& limits, TimeSpan& span) noexcept {
+    span = TimeSpan{};
+    return finder()(events, limits, &span);
 }
 
 std::vector<std::string> event_check_paths() {
@@ -175,9 +190,10 @@ std::vector<std::string> event_check_paths() {
 }
 
 std::size_t first_invalid_event_on_path(std::string_view path, std::span<const Event> events,
-                                        const EventLimits& limits) {
+                                        const EventLimits& limits, TimeSpan& span) {
+    span = TimeSpan{};
     for (const CodePath<Finder>& p : finders())
-        if (path == p.name) return p.fn(events, limits);
+        if (path == p.name) return p.fn(events, limits, &span);
     throw std::invalid_argument("event check path '" + std::string(path) + "' does not run on this CPU");
 }
 

@@ -207,15 +207,29 @@ TEST(DetectorChecks, EveryCheckPassFindsTheFirstRefusedEvent) {
                 }
             refused += want != n;
             ++cases;
-            for (const std::string& path : paths)
-                ASSERT_EQ(first_invalid_event_on_path(path, ev, *l), want)
+            // The time span found in the same pass, where every event is accepted.
+            TimeSpan plain;
+            for (const Event& e : ev) plain = plain.with({e.t, e.t});
+            for (const std::string& path : paths) {
+                TimeSpan span{1, 0};
+                ASSERT_EQ(first_invalid_event_on_path(path, ev, *l, span), want)
                     << path << ", " << n << " events, round " << round;
+                if (want == n) {
+                    ASSERT_EQ(span, plain) << path << ", " << n << " events, round " << round;
+                }
+            }
             EXPECT_EQ(first_invalid_event(ev, *l), want);
+            TimeSpan span;
+            EXPECT_EQ(first_invalid_event(ev, *l, span), want);
+            if (want == n) {
+                EXPECT_EQ(span, plain);
+            }
         }
     }
     EXPECT_GT(refused, cases / 4);  // both outcomes are exercised
     EXPECT_LT(refused, cases);
-    EXPECT_THROW((void)first_invalid_event_on_path("no-such-path", {}, open), std::invalid_argument);
+    TimeSpan span;
+    EXPECT_THROW((void)first_invalid_event_on_path("no-such-path", {}, open, span), std::invalid_argument);
 }
 
 // The unchecked forms answer as the checked ones on valid events.

@@ -178,6 +178,52 @@ TEST(EFastPaths, ArcFiredLongAgoAgainstNeverFiredPixels) {
     expect_old_arc_fires(now + 2 * kNarrow, now, now - 2 * kNarrow);
 }
 
+// The AVX-512 loop leaves out the range check while every time the detector has taken
+// spans less than 2^30 us (EFast::run_unchecked). Drawn as above, the arc and the rest
+// fed first (by detect(), by process() one event at a time, or by detect_unchecked(),
+// whose span is unknown), then the centre event alone by detect() on each path: the
+// detector must remember the earlier times: else at the largest age the arc and the
+// older rest would both narrow to the saturated value, and the corner be lost.
+TEST(EFastPaths, TheNarrowSpanCoversEveryEarlierBatch) {
+    const SensorSize s{20, 20};
+    const int x0 = 10, y0 = 10;
+    const std::int64_t now = std::int64_t{1} << 41;
+    enum class Feed { kDetect, kProcess, kUnchecked };
+    for (const std::int64_t age : {std::int64_t{5}, kNarrow - 1001, kNarrow, 4 * kNarrow}) {
+        std::vector<Event> first;
+        auto add = [&](std::int64_t t, int dx, int dy) {
+            first.push_back({t, static_cast<std::uint16_t>(x0 + dx), static_cast<std::uint16_t>(y0 + dy), 1});
+        };
+        for (int k = 0; k < 4; ++k) add(now - age, kCircle3[k].dx, kCircle3[k].dy);
+        for (int k = 0; k < 5; ++k) add(now - age, kCircle4[k].dx, kCircle4[k].dy);
+        for (int k = 4; k < 16; ++k) add(now - age - 1000, kCircle3[k].dx, kCircle3[k].dy);
+        for (int k = 5; k < 20; ++k) add(now - age - 1000, kCircle4[k].dx, kCircle4[k].dy);
+        std::sort(first.begin(), first.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
+        const Event centre{now, static_cast<std::uint16_t>(x0), static_cast<std::uint16_t>(y0), 1};
+        naive::EFastNaive oracle(s);
+        for (const Event& e : first) oracle.process(e);
+        ASSERT_TRUE(oracle.process(centre)) << "age " << age;
+        for (const std::string& path : efast_code_paths())
+            for (const Feed feed : {Feed::kDetect, Feed::kProcess, Feed::kUnchecked}) {
+                EFast det(s);
+                std::vector<std::uint8_t> flags(first.size());
+                if (feed == Feed::kDetect) detect_on_path(path, det, first, flags);
+                if (feed == Feed::kProcess)
+                    for (const Event& e : first) det.process(e);
+                if (feed == Feed::kUnchecked) detect_unchecked(det, first, flags);
+                std::uint8_t got = 7;
+                detect_on_path(path, det, std::span<const Event>(&centre, 1), std::span<std::uint8_t>(&got, 1));
+                EXPECT_EQ(got, 1) << path << ", feed " << static_cast<int>(feed) << ", age " << age;
+                const bool narrow = age + 1000 < kNarrow && feed != Feed::kUnchecked;
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+                EXPECT_EQ(det.times_within_narrow_span(), narrow) << path << ", age " << age;
+#else
+                (void)narrow;
+#endif
+            }
+    }
+}
+
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
 template <int N>
 void avx2_search_matches(std::uint32_t seed) {

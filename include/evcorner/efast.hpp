@@ -72,28 +72,46 @@ public:
     /// process_unchecked() with a chosen way of finding a circle's newest pixel (arc_test.hpp).
     template <class Search>
     bool process_unchecked_with(const Event& e) noexcept {
-        return View::template make<Search>(sae_).template process<Search>(e);
+        taken_ = taken_.with({e.t, e.t});
+        return View::template make<Search>(sae_).template process<Search, false>(e);
     }
 
     /// detect_unchecked() over a span with a chosen search. The sensor geometry and plane
     /// pointers are held in locals for the whole loop: stores of the one-byte flags may
     /// alias anything, so members would be reloaded (and offsets recomputed) every event.
+    /// `span`: the batch's time span (detect() has it from its check pass), or
+    /// TimeSpan::unknown(). On the AVX-512 path the loop leaves out the narrowed test's
+    /// range check while every time this detector has taken, this batch's included, lies
+    /// within a span narrower than efast_avx512::kNarrowSpan (17.9 minutes): no fired cell
+    /// can then be out of range. (A separate pass to find a batch's span cost more than
+    /// the check saves: on a replayed stream of millions of events it read the events from
+    /// memory twice, 10-15 % more time.) An unknown span keeps the range check for good.
     template <class Search>
-    std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-        const View v = View::template make<Search>(sae_);
-        std::size_t corners = 0;
-        for (std::size_t i = 0; i < events.size(); ++i) {
-            const bool c = v.template process<Search>(events[i]);
-            is_corner[i] = static_cast<std::uint8_t>(c);
-            corners += c;
-        }
-        return corners;
+    std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                              const TimeSpan& span = TimeSpan::unknown()) noexcept {
+        taken_ = taken_.with(span);
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        if constexpr (std::is_same_v<Search, Avx512Search>)
+            if (taken_.narrower_than(efast_avx512::kNarrowSpan)) return run_loop<Search, true>(events, is_corner);
+#endif
+        return run_loop<Search, false>(events, is_corner);
+    }
+
+    /// Whether every time this detector has taken lies within a span narrower than
+    /// efast_avx512::kNarrowSpan (the AVX-512 loop then skips the range check; for tests).
+    [[nodiscard]] bool times_within_narrow_span() const noexcept {
+#ifdef EVCORNER_HAVE_AVX2_SEARCH
+        return taken_.narrower_than(efast_avx512::kNarrowSpan);
+#else
+        return false;
+#endif
     }
 
     /// process_unchecked() that also writes the event's score (corner_scores.hpp,
     /// docs/scores.md): computed for corner events only, NaN (kNoScore) for the others.
     /// The binary paths above never compute it.
     bool process_scored_unchecked(const Event& e, double& score) noexcept {
+        taken_ = taken_.with({e.t, e.t});
         return View::template make<ScalarSearch>(sae_).template process_scored<ScalarSearch>(e, score);
     }
 
@@ -109,7 +127,8 @@ public:
         std::size_t corners = 0;
         for (std::size_t i = 0; i < events.size(); ++i) {
             const Event& e = events[i];
-            const bool c = v.template process<Search>(e);
+            taken_ = taken_.with({e.t, e.t});
+            const bool c = v.template process<Search, false>(e);
             is_corner[i] = static_cast<std::uint8_t>(c);
             corners += c;
             if (c) [[unlikely]] {
@@ -128,6 +147,18 @@ public:
     [[nodiscard]] std::size_t memory_bytes() const noexcept { return sae_.memory_bytes(); }
 
 private:
+    template <class Search, bool InRange>
+    std::size_t run_loop(std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
+        const View v = View::template make<Search>(sae_);
+        std::size_t corners = 0;
+        for (std::size_t i = 0; i < events.size(); ++i) {
+            const bool c = v.template process<Search, InRange>(events[i]);
+            is_corner[i] = static_cast<std::uint8_t>(c);
+            corners += c;
+        }
+        return corners;
+    }
+
     // The per-event path on plain values: planes, width, the inner region.
     struct View {
         std::int64_t* plane[2];
@@ -154,7 +185,8 @@ private:
             return v;
         }
 
-        template <class Search>
+        // InRange: as efast_avx512::corner() takes it (the AVX-512 path only).
+        template <class Search, bool InRange>
         bool process(const Event& e) const noexcept {
             std::int64_t* const centre = plane[e.p & 1] + static_cast<std::ptrdiff_t>(e.y) * width + e.x;
             const std::int64_t st = Sae::stored(e.t);
@@ -165,7 +197,7 @@ private:
             const std::ptrdiff_t w = width;
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
             if constexpr (std::is_same_v<Search, Avx512Search>) {
-                return efast_avx512::corner(centre, w * 8, st);
+                return efast_avx512::corner<InRange>(centre, w * 8, st);
             } else
 #endif
             {
@@ -194,13 +226,14 @@ private:
         // process() and, for a corner, its score.
         template <class Search>
         bool process_scored(const Event& e, double& s) const noexcept {
-            const bool c = process<Search>(e);
+            const bool c = process<Search, false>(e);
             s = c ? score(e) : kNoScore;
             return c;
         }
     };
 
     Sae sae_;
+    TimeSpan taken_;  // the times of every event taken (written into the SAE) so far
 };
 static_assert(Detector<EFast>);
 static_assert(ScoredDetector<EFast>);

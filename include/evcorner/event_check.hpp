@@ -49,10 +49,37 @@ private:
     SensorSize sensor_;
 };
 
+/// The least and the greatest time in a batch of events (lo > hi for no events).
+struct TimeSpan {
+    std::int64_t lo = std::numeric_limits<std::int64_t>::max();
+    std::int64_t hi = std::numeric_limits<std::int64_t>::min();
+
+    /// Every time: what a caller that does not know a batch's span passes.
+    [[nodiscard]] static constexpr TimeSpan unknown() noexcept {
+        return {std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()};
+    }
+    [[nodiscard]] constexpr bool empty() const noexcept { return lo > hi; }
+    /// The span holding both this one and `o`.
+    [[nodiscard]] constexpr TimeSpan with(const TimeSpan& o) const noexcept {
+        return {lo < o.lo ? lo : o.lo, hi > o.hi ? hi : o.hi};
+    }
+    /// Whether every two times in the span lie less than `width` us apart (an empty span
+    /// does). Exact for any times (hi - lo in unsigned arithmetic).
+    [[nodiscard]] constexpr bool narrower_than(std::int64_t width) const noexcept {
+        return empty() || static_cast<std::uint64_t>(hi) - static_cast<std::uint64_t>(lo) <
+                              static_cast<std::uint64_t>(width);
+    }
+    friend constexpr bool operator==(const TimeSpan&, const TimeSpan&) = default;
+};
+
 /// Index of the first event that `limits` does not accept, or events.size() if none.
 /// One tight pass: blocks of events are tested without a branch per event, with AVX-512
 /// or AVX2 where the CPU has it (chosen at run time).
 [[nodiscard]] std::size_t first_invalid_event(std::span<const Event> events, const EventLimits& limits) noexcept;
+/// The same, and in `span` the batch's time span (found in the same pass; meaningful
+/// only when every event is accepted).
+[[nodiscard]] std::size_t first_invalid_event(std::span<const Event> events, const EventLimits& limits,
+                                              TimeSpan& span) noexcept;
 
 /// The passes first_invalid_event() may take on this CPU ("avx512", "avx2", "portable"),
 /// the one it takes first.
@@ -60,7 +87,7 @@ private:
 /// first_invalid_event() on a named pass (one of event_check_paths(); else
 /// std::invalid_argument): for tests and benchmarks.
 [[nodiscard]] std::size_t first_invalid_event_on_path(std::string_view path, std::span<const Event> events,
-                                                      const EventLimits& limits);
+                                                      const EventLimits& limits, TimeSpan& span);
 /// Throws InvalidEvent unless `limits` accepts `e`.
 inline void check_event(const Event& e, const EventLimits& limits) {
     if (!limits.accepts(e)) [[unlikely]]
@@ -73,6 +100,14 @@ inline void check_events(std::span<const Event> events, const EventLimits& limit
     const std::size_t i = first_invalid_event(events, limits);
     if (i != events.size()) [[unlikely]]
         throw InvalidEvent(events[i], limits, i);
+}
+/// check_events() that also answers the batch's time span, from the same pass.
+[[nodiscard]] inline TimeSpan check_events_span(std::span<const Event> events, const EventLimits& limits) {
+    TimeSpan span;
+    const std::size_t i = first_invalid_event(events, limits, span);
+    if (i != events.size()) [[unlikely]]
+        throw InvalidEvent(events[i], limits, i);
+    return span;
 }
 
 }  // namespace evcorner
