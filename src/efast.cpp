@@ -99,6 +99,11 @@ std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::spa
     return choice().fn(det, events, is_corner, TimeSpan::unknown());
 }
 
+std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             const TimeSpan& span) noexcept {
+    return choice().fn(det, events, is_corner, span);
+}
+
 std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
                    std::span<double> score) {
     detail::check_flags(events.size(), is_corner.size(), "detect");

@@ -96,6 +96,22 @@ TEST(ParallelDetect, EFastBundledSample) {
     expect_same_as_one_thread<EFast>(events, kDavis240, kCircleMargin, [](SensorSize z, int planes) { return EFast(z, planes); }, 1 << 16);
 }
 
+// eFAST's parts get each batch's time span (ParallelDetector passes it down), and leave
+// out the AVX-512 range check only while every time a part has taken spans less than
+// 2^30 us: gaps just under and over that, and far beyond, between batches.
+TEST(ParallelDetect, EFastAcrossGapsBeyondTheNarrowRange) {
+    const SensorSize s{240, 180};
+    std::vector<Event> events = random_stream(s, 60000, 13);
+    const std::int64_t narrow = std::int64_t{1} << 30;
+    const std::int64_t gaps[] = {narrow - 3, narrow + 1, std::int64_t{1} << 40, 2 * narrow};
+    std::int64_t shift = 0;
+    for (std::size_t i = 0; i < events.size(); ++i) {
+        if (i > 0 && i % 9000 == 0) shift += gaps[(i / 9000) % std::size(gaps)];
+        events[i].t += shift;
+    }
+    expect_same_as_one_thread<EFast>(events, s, kCircleMargin, [](SensorSize z, int planes) { return EFast(z, planes); }, 5000);
+}
+
 TEST(ParallelDetect, HarrisRandomHdStream) {
     const SensorSize hd{1280, 720};
     const auto events = random_stream(hd, 40000, 5);

@@ -247,6 +247,11 @@ std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uin
 /// detect() without the checks: every event accepted by det.limits(), is_corner at
 /// least as long as events.
 std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
+/// detect_unchecked() for a caller that knows times holding the batch's (`span`, as
+/// check_events_span() gives it): the AVX-512 loop may then leave out its range check
+/// (EFast::run_unchecked). ParallelDetector's parts take this one.
+std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                             const TimeSpan& span) noexcept;
 
 /// detect() with scores (scored_detector.hpp) on the same code path as detect(): the
 /// flags are those of detect(); score[i] is eFAST's score for a corner, NaN otherwise.

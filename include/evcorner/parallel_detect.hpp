@@ -93,10 +93,15 @@ std::vector<DetectPart> plan_parts(SensorSize size, int bands, int radius, std::
 
 namespace detail {
 // The detector's batch loops: unqualified calls, so that argument-dependent lookup
-// finds a detector's own overload (eFAST's, in efast.hpp) over the generic one.
+// finds a detector's own overload (eFAST's, in efast.hpp) over the generic one. `span`
+// holds the batch's times; a detector with an overload that takes it (eFAST) gets it.
 template <class D>
-std::size_t run_batch(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept {
-    return detect_unchecked(det, events, is_corner);
+std::size_t run_batch(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
+                      const TimeSpan& span) noexcept {
+    if constexpr (requires { detect_unchecked(det, events, is_corner, span); })
+        return detect_unchecked(det, events, is_corner, span);
+    else
+        return detect_unchecked(det, events, is_corner);
 }
 template <class D>
 std::size_t run_batch_checked(D& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) {
@@ -156,16 +161,17 @@ public:
         if (queued_ != 0) throw std::logic_error("ParallelDetector::detect: batches prepared and not run");
         if (is_corner.size() < events.size())
             throw std::invalid_argument("ParallelDetector::detect: fewer flags than events");
-        check_events(events, limits_);
+        // The whole span's times hold every batch's (what eFAST's parts use: efast.hpp).
+        const TimeSpan span = check_events_span(events, limits_);
         std::size_t corners = 0;
         if (events.empty()) return 0;
-        prepare_unchecked(events.first(std::min(kMaxBatch, events.size())));
+        prepare_unchecked(events.first(std::min(kMaxBatch, events.size())), span);
         for (std::size_t at = 0; at < events.size(); at += kMaxBatch) {
             const std::size_t n = std::min(kMaxBatch, events.size() - at);
             const std::size_t next = at + n;
             corners += run(is_corner.subspan(at, n), [&] {
                 if (next < events.size())
-                    prepare_unchecked(events.subspan(next, std::min(kMaxBatch, events.size() - next)));
+                    prepare_unchecked(events.subspan(next, std::min(kMaxBatch, events.size() - next)), span);
             });
         }
         return corners;
@@ -176,15 +182,17 @@ public:
     /// first batch plans the parts. Throws InvalidEvent for the first event limits() does
     /// not accept (nothing queued).
     void prepare(std::span<const Event> events) {
-        check_events(events, limits_);
-        prepare_unchecked(events);
+        const TimeSpan span = check_events_span(events, limits_);
+        prepare_unchecked(events, span);
     }
     /// prepare() without the check of the events: each must be accepted by limits().
-    void prepare_unchecked(std::span<const Event> events) {
+    /// `span`: times holding the batch's (event_check.hpp), or TimeSpan::unknown().
+    void prepare_unchecked(std::span<const Event> events, const TimeSpan& span = TimeSpan::unknown()) {
         if (events.size() > kMaxBatch) throw std::length_error("ParallelDetector::prepare: batch too large");
         if (queued_ == 2) throw std::logic_error("ParallelDetector::prepare: two batches queued already");
         if (plan_.empty()) make_parts(events);
         Slot& s = slots_[(front_ + queued_) % 2];
+        s.span = span;
         scatter(events, s);
         ++queued_;
     }
@@ -253,6 +261,7 @@ private:
         std::vector<detail::RawBuffer<std::uint32_t>> at;  // their positions in the batch (| kHalo)
         std::vector<std::uint32_t> count;
         std::vector<std::uint32_t> order;  // parts with events, largest first
+        TimeSpan span;                     // holds the batch's times
     };
 
     [[nodiscard]] int part_planes() const noexcept { return split_polarity_ ? 1 : 2; }
@@ -342,7 +351,7 @@ private:
         std::uint8_t* flags = part.flags.data.get();
         // The detector's own batch loop over band and halo events alike; answers for
         // halo events are dropped (a halo is a few rows).
-        detail::run_batch(*part.detector, std::span<const Event>(ev, m), std::span<std::uint8_t>(flags, m));
+        detail::run_batch(*part.detector, std::span<const Event>(ev, m), std::span<std::uint8_t>(flags, m), s.span);
         std::uint32_t* corners = part.corners.data.get();
         std::size_t found = 0;
         for (std::size_t k = 0; k < m; ++k) {
