@@ -85,7 +85,7 @@ public:
     /// within a span narrower than efast_avx512::kNarrowSpan (17.9 minutes): no fired cell
     /// can then be out of range. (A separate pass to find a batch's span cost more than
     /// the check saves: on a replayed stream of millions of events it read the events from
-    /// memory twice, 10-15 % more time.) An unknown span keeps the range check for good.
+    /// memory twice, 11-27 % more time.) An unknown span keeps the range check for good.
     template <class Search>
     std::size_t run_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner,
                               const TimeSpan& span = TimeSpan::unknown()) noexcept {
