@@ -39,20 +39,22 @@ std::size_t detect_portable(EFast& det, std::span<const Event> events, std::span
 using Loop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>, const TimeSpan&) noexcept;
 
 // The scored loops (detect with scores), one per path, beside the binary ones.
-using ScoredLoop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>, std::span<double>) noexcept;
+using ScoredLoop = std::size_t (*)(EFast&, std::span<const Event>, std::span<std::uint8_t>, std::span<double>,
+                                  const TimeSpan&) noexcept;
 std::size_t scored_portable(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
-                            std::span<double> score) noexcept {
-    return det.run_scored_unchecked<ScalarSearch>(events, is_corner, score);
+                            std::span<double> score, const TimeSpan& span) noexcept {
+    return det.run_scored_unchecked<ScalarSearch>(events, is_corner, score, span);
 }
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
 [[gnu::target("avx2"), gnu::flatten]] std::size_t scored_avx2(EFast& det, std::span<const Event> events,
                                                                std::span<std::uint8_t> is_corner,
-                                                               std::span<double> score) noexcept {
-    return det.run_scored_unchecked<Avx2Search>(events, is_corner, score);
+                                                               std::span<double> score, const TimeSpan& span) noexcept {
+    return det.run_scored_unchecked<Avx2Search>(events, is_corner, score, span);
 }
 [[gnu::target(EVCORNER_AVX512_TARGET), gnu::flatten]] std::size_t scored_avx512(
-    EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner, std::span<double> score) noexcept {
-    return det.run_scored_unchecked<Avx512Search>(events, is_corner, score);
+    EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner, std::span<double> score,
+    const TimeSpan& span) noexcept {
+    return det.run_scored_unchecked<Avx512Search>(events, is_corner, score, span);
 }
 #endif
 ScoredLoop scored_loop_of(Loop loop) noexcept {
@@ -108,13 +110,13 @@ std::size_t detect(EFast& det, std::span<const Event> events, std::span<std::uin
                    std::span<double> score) {
     detail::check_flags(events.size(), is_corner.size(), "detect");
     detail::check_flags(events.size(), score.size(), "detect (scores)");
-    check_events(events, det.limits());
-    return scored_loop_of(choice().fn)(det, events, is_corner, score);
+    const TimeSpan span = check_events_span(events, det.limits());
+    return scored_loop_of(choice().fn)(det, events, is_corner, score, span);
 }
 
 std::size_t detect_unchecked(EFast& det, std::span<const Event> events, std::span<std::uint8_t> is_corner,
                              std::span<double> score) noexcept {
-    return scored_loop_of(choice().fn)(det, events, is_corner, score);
+    return scored_loop_of(choice().fn)(det, events, is_corner, score, TimeSpan::unknown());
 }
 
 const char* efast_code_path() noexcept { return choice().name; }

@@ -180,15 +180,15 @@ TEST(EFastPaths, ArcFiredLongAgoAgainstNeverFiredPixels) {
 
 // The AVX-512 loop leaves out the range check while every time the detector has taken
 // spans less than 2^30 us (EFast::run_unchecked). Drawn as above, the arc and the rest
-// fed first (by detect(), by process() one event at a time, or by detect_unchecked(),
-// whose span is unknown), then the centre event alone by detect() on each path: the
+// fed first (by detect(), by process() one event at a time, by detect() with scores, or
+// by detect_unchecked(), whose span is unknown), then the centre event alone by detect() on each path: the
 // detector must remember the earlier times: else at the largest age the arc and the
 // older rest would both narrow to the saturated value, and the corner be lost.
 TEST(EFastPaths, TheNarrowSpanCoversEveryEarlierBatch) {
     const SensorSize s{20, 20};
     const int x0 = 10, y0 = 10;
     const std::int64_t now = std::int64_t{1} << 41;
-    enum class Feed { kDetect, kProcess, kUnchecked };
+    enum class Feed { kDetect, kProcess, kUnchecked, kScored };
     for (const std::int64_t age : {std::int64_t{5}, kNarrow - 1001, kNarrow, 4 * kNarrow}) {
         std::vector<Event> first;
         auto add = [&](std::int64_t t, int dx, int dy) {
@@ -204,13 +204,17 @@ TEST(EFastPaths, TheNarrowSpanCoversEveryEarlierBatch) {
         for (const Event& e : first) oracle.process(e);
         ASSERT_TRUE(oracle.process(centre)) << "age " << age;
         for (const std::string& path : efast_code_paths())
-            for (const Feed feed : {Feed::kDetect, Feed::kProcess, Feed::kUnchecked}) {
+            for (const Feed feed : {Feed::kDetect, Feed::kProcess, Feed::kUnchecked, Feed::kScored}) {
                 EFast det(s);
                 std::vector<std::uint8_t> flags(first.size());
                 if (feed == Feed::kDetect) detect_on_path(path, det, first, flags);
                 if (feed == Feed::kProcess)
                     for (const Event& e : first) det.process(e);
                 if (feed == Feed::kUnchecked) detect_unchecked(det, first, flags);
+                if (feed == Feed::kScored) {
+                    std::vector<double> scores(first.size());
+                    detect(det, first, flags, scores);
+                }
                 std::uint8_t got = 7;
                 detect_on_path(path, det, std::span<const Event>(&centre, 1), std::span<std::uint8_t>(&got, 1));
                 EXPECT_EQ(got, 1) << path << ", feed " << static_cast<int>(feed) << ", age " << age;

@@ -118,16 +118,16 @@ public:
     /// run_unchecked() with scores (score[i] as process_scored_unchecked() writes it). The
     /// scores start as NaN in one pass; the loop is run_unchecked()'s plus, for a corner
     /// only, a call to the score (out of line, so that the per-event path stays the
-    /// binary one's).
+    /// binary one's). `span` as for run_unchecked(); this loop always keeps the range check.
     template <class Search>
     std::size_t run_scored_unchecked(std::span<const Event> events, std::span<std::uint8_t> is_corner,
-                                     std::span<double> score) noexcept {
+                                     std::span<double> score, const TimeSpan& span = TimeSpan::unknown()) noexcept {
+        taken_ = taken_.with(span);
         const View v = View::template make<Search>(sae_);
         std::fill_n(score.begin(), events.size(), kNoScore);
         std::size_t corners = 0;
         for (std::size_t i = 0; i < events.size(); ++i) {
             const Event& e = events[i];
-            taken_ = taken_.with({e.t, e.t});
             const bool c = v.template process<Search, false>(e);
             is_corner[i] = static_cast<std::uint8_t>(c);
             corners += c;
