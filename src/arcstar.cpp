@@ -5,10 +5,10 @@
 
 #include "evcorner/arcstar.hpp"
 
-#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "evcorner/cpu_paths.hpp"
 
@@ -41,30 +41,26 @@ std::size_t detect_portable(ArcStar& det, std::span<const Event> events, std::sp
 #endif
 
 using Loop = std::size_t (*)(ArcStar&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
+using Path = CodePath<Loop>;
 
-struct Path {
-    const char* name;
-    Loop loop;
-};
-
-// The fastest path this CPU runs, or the one EVCORNER_ARCSTAR_PATH names if it runs it.
-Path choose() noexcept {
-    const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
-    const auto wanted = [forced](const char* name) { return forced == nullptr || std::strcmp(forced, name) == 0; };
+// The paths this CPU runs, fastest first.
+std::vector<Path> available() {
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-    if (wanted("avx512") && cpu_runs_avx512())
-        return {"avx512", detect_avx512};
-    if ((wanted("avx2") || wanted("avx512")) && cpu_runs_avx2()) return {"avx2", detect_avx2};
+    return runnable_paths<Loop>(detect_avx512, detect_avx2, detect_portable);
+#else
+    return runnable_paths<Loop>(nullptr, nullptr, detect_portable);
 #endif
-    return {"portable", detect_portable};
 }
 
+// The fastest path, or the one EVCORNER_ARCSTAR_PATH names if this CPU runs it; chosen
+// once per process.
 const Path& path() noexcept {
-    static const Path p = choose();
+    static const std::vector<Path> paths = available();
+    static const Path& p = forced_or_fastest(paths, "EVCORNER_ARCSTAR_PATH");
     return p;
 }
 
-Loop loop() noexcept { return path().loop; }
+Loop loop() noexcept { return path().fn; }
 
 }  // namespace
 

@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <bit>
-#include <cstdlib>
-#include <cstring>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "evcorner/circle.hpp"
 #include "evcorner/cpu_paths.hpp"
@@ -339,18 +338,14 @@ std::size_t run_portable(FaHarris& det, std::span<const Event> events, std::span
 using Loop = std::size_t (*)(FaHarris&, std::span<const Event>, std::span<std::uint8_t>) noexcept;
 
 // The fastest loop this CPU runs, or the one EVCORNER_ARCSTAR_PATH names if it runs it (as
-// Arc*'s, arcstar.cpp).
+// Arc*'s, arcstar.cpp); chosen once per process.
 Loop loop() noexcept {
-    static const Loop l = [] {
-        const char* forced = std::getenv("EVCORNER_ARCSTAR_PATH");
-        const auto wanted = [forced](const char* name) { return forced == nullptr || std::strcmp(forced, name) == 0; };
 #ifdef EVCORNER_HAVE_AVX2_SEARCH
-        if (wanted("avx512") && cpu_runs_avx512())
-            return static_cast<Loop>(run_avx512);
-        if ((wanted("avx2") || wanted("avx512")) && cpu_runs_avx2()) return static_cast<Loop>(run_avx2);
+    static const std::vector<CodePath<Loop>> paths = runnable_paths<Loop>(run_avx512, run_avx2, run_portable);
+#else
+    static const std::vector<CodePath<Loop>> paths = runnable_paths<Loop>(nullptr, nullptr, run_portable);
 #endif
-        return static_cast<Loop>(run_portable);
-    }();
+    static const Loop l = forced_or_fastest(paths, "EVCORNER_ARCSTAR_PATH").fn;
     return l;
 }
 

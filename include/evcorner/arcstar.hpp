@@ -276,7 +276,7 @@ static_assert(ScoredDetector<ArcStar>);
 
 /// detect() for Arc*: the same flags, with the fastest code this CPU runs (AVX-512, else
 /// AVX2, else portable), chosen once per process; EVCORNER_ARCSTAR_PATH=portable|avx2|avx512
-/// forces one this CPU runs. Checks as the generic
+/// forces one this CPU runs (any other value: the fastest). Checks as the generic
 /// detect() does (InvalidEvent before any event is processed).
 std::size_t detect(ArcStar& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
 /// detect() without the checks.

@@ -116,9 +116,10 @@ private:
 };
 static_assert(ScoredDetector<FaHarris>);
 
-/// detect() for FA-Harris: the same flags, with the AVX2 newest-pixel search where the CPU
-/// has it (EVCORNER_ARCSTAR_PATH=portable forces the portable loop). Checks as the generic
-/// detect() does. (detect() with scores is the generic one of scored_detector.hpp.)
+/// detect() for FA-Harris: the same flags, with the fastest loop this CPU runs (AVX-512:
+/// Arc*'s closed form for the candidate stage; else AVX2; else portable), chosen once per
+/// process; EVCORNER_ARCSTAR_PATH=portable|avx2|avx512 forces one this CPU runs. Checks as
+/// the generic detect() does. (detect() with scores is the generic one of scored_detector.hpp.)
 std::size_t detect(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner);
 /// detect() without the checks.
 std::size_t detect_unchecked(FaHarris& det, std::span<const Event> events, std::span<std::uint8_t> is_corner) noexcept;
