@@ -55,7 +55,7 @@ TEST(FuzzRegression, CsvTimestampOfNineteenDigitsIsAnError) {
 
 // fuzz_mat: a 360-byte MAT v5 file whose events variable declares 2^31 x 4 doubles; libmatio
 // allocated 64 GB before reading (out of memory under ASan). It must be a clear error
-// naming the declared size, without the allocation.
+// naming the damage, without the allocation.
 TEST(FuzzRegression, MatVariableLargerThanTheFileIsAnError) {
     static const unsigned char kFile[] = {
     0x4d, 0x41, 0x54, 0x4c, 0x41, 0x42, 0x20, 0x35, 0x2e, 0x30, 0x20, 0x4d, 0x41, 0x54, 0x2d, 0x66, 0x69, 0x6c, 0x65, 0x2c,
@@ -77,6 +77,9 @@ TEST(FuzzRegression, MatVariableLargerThanTheFileIsAnError) {
     0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xf0, 0xbf, 0x00, 0x00, 0x25, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
     0x00, 0x00, 0x24, 0x40, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x32, 0x40, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x3e, 0x40,
     };
+    // Since the tag walk before libmatio (mat_reader.cpp), the damage is found in the
+    // dimensions themselves (2^31 - 2^27 + 4 rows of 4 columns in a 184-byte matrix), before
+    // the variable's declared data, and before the 40 damaged bytes after it (byte 320).
     TempDir dir;
     const std::string path = dir.path("huge.mat");
     {
@@ -88,9 +91,10 @@ TEST(FuzzRegression, MatVariableLargerThanTheFileIsAnError) {
         FAIL() << "a variable of 2^31 rows in a 360-byte file was accepted";
     } catch (const InputError& e) {
         const std::string what = e.what();
-        EXPECT_NE(what.find("huge.mat"), std::string::npos) << what;
-        EXPECT_NE(what.find("declares 64424509568 bytes"), std::string::npos) << what;
-        EXPECT_NE(what.find("damaged"), std::string::npos) << what;
+        EXPECT_NE(what.find("huge.mat: byte offset 152: the dimensions of a variable hold 8053063696 elements, more "
+                            "than the 184 bytes of its matrix element: the file is damaged"),
+                  std::string::npos)
+            << what;
     }
 }
 

@@ -11,6 +11,7 @@
 #include <zstd.h>
 
 #include <cstring>
+#include <fstream>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -583,6 +584,152 @@ TEST(Mat, VariableAndColumnsByOption) {
         EXPECT_NE(std::string(e.what()).find("no N x 4 real numeric variable"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("'m' (2x3 double)"), std::string::npos) << e.what();
     }
+}
+
+// A MAT 5 file written byte by byte (little-endian): the 128-byte header, then `elements`.
+std::string mat5_file(const std::string& elements) {
+    std::string head(128, ' ');
+    const std::string text = "MATLAB 5.0 MAT-file, written by test_more_formats";
+    head.replace(0, text.size(), text);
+    std::fill(head.begin() + 116, head.begin() + 124, '\0');  // no subsystem data
+    head[124] = '\0';
+    head[125] = '\1';  // version 0x0100
+    head[126] = 'I';
+    head[127] = 'M';  // written little-endian
+    return head + elements;
+}
+std::string le32(std::uint32_t v) {
+    std::string b(4, '\0');
+    for (int i = 0; i < 4; ++i) b[i] = static_cast<char>(v >> (8 * i));
+    return b;
+}
+// A 1 x 4 double matrix "ev" holding x, y, p, t = 1, 2, 1, 5; its dimensions tag declares
+// `dims_bytes` (8: the true two dimensions).
+std::string mat5_matrix(std::uint32_t dims_bytes) {
+    std::string body = le32(6) + le32(8) + le32(6) + le32(0);              // array flags: double
+    body += le32(5) + le32(dims_bytes) + le32(1) + le32(4);                 // dimensions 1 x 4
+    body += le32(1 | 2u << 16) + std::string("ev\0\0", 4);               // name, small element
+    body += le32(9) + le32(32);                                             // real part: 4 doubles
+    for (const double v : {1.0, 2.0, 1.0, 5.0}) body += std::string(reinterpret_cast<const char*>(&v), 8);
+    return le32(14) + le32(static_cast<std::uint32_t>(body.size())) + body;  // miMATRIX
+}
+std::string deflated(const std::string& raw) {
+    uLongf n = compressBound(raw.size());
+    std::string z(n, '\0');
+    EXPECT_EQ(compress2(reinterpret_cast<Bytef*>(z.data()), &n, reinterpret_cast<const Bytef*>(raw.data()), raw.size(), 6),
+              Z_OK);
+    z.resize(n);
+    return le32(15) + le32(static_cast<std::uint32_t>(n)) + z;  // miCOMPRESSED
+}
+// A compressed element holding the first `keep` bytes of `raw`, flushed, then bytes that
+// are no deflate data: a stream damaged after its start.
+std::string deflated_then_damaged(const std::string& raw, std::size_t keep) {
+    z_stream zs{};
+    EXPECT_EQ(deflateInit(&zs, 6), Z_OK);
+    std::string z(compressBound(keep) + 64, '\0');
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(raw.data()));
+    zs.avail_in = static_cast<uInt>(keep);
+    zs.next_out = reinterpret_cast<Bytef*>(z.data());
+    zs.avail_out = static_cast<uInt>(z.size());
+    EXPECT_EQ(deflate(&zs, Z_FULL_FLUSH), Z_OK);
+    z.resize(z.size() - zs.avail_out);
+    deflateEnd(&zs);
+    z += std::string(16, '\xff');
+    return le32(15) + le32(static_cast<std::uint32_t>(z.size())) + z;
+}
+std::string refusal(const std::string& path, std::string_view format = "auto") {
+    try {
+        io::open_event_reader(path, {}, format);
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// libmatio allocates a variable's dimensions array by the byte count of its tag before it
+// reads it (fuzz_mat: 4 GiB declared in a 420-byte file, an 8 GiB allocation): the tags are
+// checked first, and damage is an error at its byte offset.
+TEST(Mat, DamagedTagsAreRefusedAtTheirByteOffset) {
+    TempDir tmp;
+    const auto write = [&](const std::string& name, const std::string& bytes) {
+        const std::string path = tmp.path(name);
+        std::ofstream(path, std::ios::binary) << bytes;
+        return path;
+    };
+    io::ReaderOptions o;
+    o.fallback_sensor = std::nullopt;
+    // The same bytes with true tags read (uncompressed and compressed): the layout is sound.
+    const std::vector<Event> one{{5, 1, 2, 1}};
+    EXPECT_EQ(read_path(write("good.mat", mat5_file(mat5_matrix(8))), o), one);
+    EXPECT_EQ(read_path(write("good-z.mat", mat5_file(deflated(mat5_matrix(8)))), o), one);
+
+    // Dimensions declaring 4 GiB: the tag at byte 128 + 8 + 16.
+    std::string w = refusal(write("dims.mat", mat5_file(mat5_matrix(0xFFFF0008u))));
+    EXPECT_NE(w.find("dims.mat"), std::string::npos) << w;
+    EXPECT_NE(w.find("byte offset 152: the dimensions of a variable declare 4294901768 bytes"), std::string::npos) << w;
+    EXPECT_NE(w.find("damaged"), std::string::npos) << w;
+    // The same inside a compressed element.
+    w = refusal(write("dims-z.mat", mat5_file(deflated(mat5_matrix(0xFFFF0008u)))));
+    EXPECT_NE(w.find("byte offset 128 (a compressed variable, byte 24 of its decompressed data): the dimensions"),
+              std::string::npos)
+        << w;
+    // The same in a stream damaged after the dimensions (fuzz_mat: libmatio read the header
+    // before it met the damage).
+    w = refusal(write("dims-zbad.mat", mat5_file(deflated_then_damaged(mat5_matrix(0xFFFF0008u), 48))));
+    EXPECT_NE(w.find("byte offset 128 (a compressed variable, byte 24 of its decompressed data): the dimensions"),
+              std::string::npos)
+        << w;
+    // A compressed element whose matrix declares more than its compressed bytes can hold.
+    std::string big = mat5_matrix(8);
+    big.replace(4, 4, le32(0x7FFFFFF0u));
+    w = refusal(write("big-z.mat", mat5_file(deflated(big))));
+    EXPECT_NE(w.find("byte offset 128: a compressed variable declares 2147483632 bytes"), std::string::npos) << w;
+    // One word of the true matrix replaced: each a damage fuzz_mat found.
+    struct Damage {
+        const char* file;
+        std::uint32_t dims_bytes;  // for mat5_matrix()
+        std::size_t at;            // byte of the element replaced
+        std::uint32_t word;
+        const char* says;
+    };
+    const Damage damages[] = {
+        // Array flags with a damaged tag: libmatio read them as 16 bytes all the same, then
+        // a name tag declaring 3.3 GB, and filled 3.3 GB of memory.
+        {"flags.mat", 8, 8, 0x000E0000u,
+         "byte offset 136: the array flags of a variable have a damaged tag (type 0, 14 bytes"},
+        // Dimensions of a foreign type, one dimension: libmatio then took its name tag from
+        // the wrong place, a name of 2.6 GB.
+        {"foreign.mat", 4, 24, 69, "byte offset 152: the dimensions of a variable have a damaged tag (type 69, 4 bytes"},
+        // More elements than the matrix element has bytes (4 x 687 865 860 in 320 bytes),
+        // which libmatio sized allocations by.
+        {"rows.mat", 8, 32, 1000000000u,
+         "byte offset 152: the dimensions of a variable hold 4000000000 elements, more than the 80 bytes"},
+    };
+    for (const Damage& d : damages) {
+        std::string m = mat5_matrix(d.dims_bytes);
+        m.replace(d.at, 4, le32(d.word));
+        w = refusal(write(d.file, mat5_file(m)));
+        EXPECT_NE(w.find(d.says), std::string::npos) << d.file << ": " << w;
+    }
+    // A file cut short inside its element.
+    const std::string whole = mat5_file(mat5_matrix(8));
+    w = refusal(write("cut.mat", whole.substr(0, whole.size() - 8)));
+    EXPECT_NE(w.find("byte offset 128: a data element declares 80 bytes, but only 72 follow its tag"), std::string::npos)
+        << w;
+    // Level 4 (no 128-byte header: libmatio allocated the name length of its header, 1.7 GB
+    // for a damaged 357-byte file) and files shorter than the header are refused.
+    // (Nothing tells a Level 4 file by its content: only --format mat reads it as one.)
+    w = refusal(write_mat(tmp.path("v4.mat"), {{"events", columns({1, 2, 3, 0}), 4, 4}}, MAT_FT_MAT4), "mat");
+    EXPECT_NE(w.find("v4.mat: bytes 124-127 hold no MAT-file version"), std::string::npos) << w;
+    EXPECT_NE(w.find("Level 4 MAT-files are not read"), std::string::npos) << w;
+    w = refusal(write("short.mat", mat5_file("").substr(0, 100)));
+    EXPECT_NE(w.find("short.mat: 100 bytes, shorter than the 128-byte header of a MAT-file"), std::string::npos) << w;
+    // Read before this check, that file gave its one event with t = 0 instead of 5. A
+    // compressed one cut short is refused the same way.
+    const std::string whole_z = mat5_file(deflated(mat5_matrix(8)));
+    w = refusal(write("cut-z.mat", whole_z.substr(0, whole_z.size() - 3)));
+    EXPECT_NE(w.find("byte offset 128: a data element declares"), std::string::npos) << w;
+    EXPECT_NE(w.find("cut short"), std::string::npos) << w;
 }
 
 // ---------------------------------------------------------------- unsupported kinds

@@ -3,10 +3,13 @@
 #include <fmt/format.h>
 #include <matio.h>
 #include <sys/stat.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <fstream>
 #include <mutex>
 
 #include "evcorner/error.hpp"
@@ -92,6 +95,196 @@ std::string describe(const matvar_t* v) {
                        v->isComplex ? ", complex" : "");
 }
 
+// ---------------------------------------------------------------- MAT 5 tags, before libmatio
+// libmatio sizes some allocations by the tags of a variable's header before it reads them,
+// and does not see a file cut short:
+// - Mat_VarReadNextInfo allocates the dimensions array from the byte count of its tag: a
+//   420-byte file whose dimensions declared 4 GiB made it ask for 8 GiB (fuzz_mat), and the
+//   scan then ended in "no variable" rather than in the damage;
+// - array flags with a damaged tag, then a name tag declaring 3.3 GB: 3.3 GB of memory
+//   filled for a 325-byte file (fuzz_mat, fuzz/seeds/regress-damaged-flags.mat);
+// - an uncompressed variable missing its last bytes read them as zeros (a time of 0).
+// So the element
+// tags of a MAT 5 file are walked here first (the MAT-File Format's Level 5 layout: a
+// 128-byte header, then data elements, each an 8-byte tag of type and byte count, or a
+// 4-byte "small element" tag when the count's half of the first word is not zero; a matrix
+// opens with its array flags, dimensions and name sub-elements; a compressed element is a
+// zlib stream holding one such element). MAT 7.3 files (HDF5 inside) are not walked, and
+// Level 4 files are refused (check_mat_file()).
+constexpr std::uint32_t kMiMatrix = 14;
+constexpr std::uint32_t kMiCompressed = 15;
+// Deflate expands at most 1032:1 (as for the declared data below).
+constexpr std::uint64_t kMaxInflation = 1032;
+
+struct Mat5Tag {
+    std::uint32_t type;
+    std::uint32_t bytes;
+    bool small;  // 4-byte tag, data in the tag's second word
+    // The bytes the element takes with its tag, sub-elements padded to 8 bytes.
+    [[nodiscard]] std::uint64_t padded() const noexcept { return small ? 8 : 8 + ((std::uint64_t{bytes} + 7) & ~std::uint64_t{7}); }
+};
+
+class Mat5Walk {
+public:
+    Mat5Walk(const std::string& name, bool little) : name_(name), little_(little) {}
+
+    [[nodiscard]] std::uint32_t word(const unsigned char* p) const noexcept {
+        return little_ ? std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24
+                       : std::uint32_t{p[3]} | std::uint32_t{p[2]} << 8 | std::uint32_t{p[1]} << 16 | std::uint32_t{p[0]} << 24;
+    }
+    [[nodiscard]] Mat5Tag tag(const unsigned char* p) const noexcept {
+        const std::uint32_t w = word(p);
+        if ((w >> 16) != 0) return {w & 0xFFFF, w >> 16, true};
+        return {w, word(p + 4), false};
+    }
+
+    // The array flags, dimensions and name of a matrix whose content declares `declared`
+    // bytes; `body` holds the first `have` of them. The matrix element's tag lies at byte
+    // offset `at` of the file, or (`compressed`) begins the stream of the compressed
+    // element at `at`.
+    void check_matrix(std::uint64_t at, const unsigned char* body, std::size_t have, std::uint64_t declared,
+                      bool compressed) const {
+        // What each sub-element must be (the format fixes them): the array flags 8 bytes of
+        // miUINT32 (6), the dimensions 4 bytes of miINT32 (5) per dimension and at least
+        // two, the name miINT8 (1), a small element when it has 4 characters or fewer.
+        // A tag out of form shifts what libmatio reads next away from what is checked here:
+        // it reads the flags as 8 bytes whatever their tag says, and after dimensions of
+        // type 69 and 4 bytes it took its name tag from 4 bytes before where the format
+        // puts it (fuzz_mat: a name of 2.6 GB, fuzz/seeds/regress-damaged-dims-type.mat).
+        struct Part {
+            const char* name;
+            const char* expected;
+            bool (*valid)(const Mat5Tag&);
+        };
+        static constexpr Part kParts[] = {
+            {"array flags", "8 bytes of type 6, miUINT32",
+             [](const Mat5Tag& t) { return !t.small && t.type == 6 && t.bytes == 8; }},
+            {"dimensions", "type 5, miINT32, 4 bytes per dimension and at least 8",
+             [](const Mat5Tag& t) { return !t.small && t.type == 5 && t.bytes % 4 == 0 && t.bytes >= 8; }},
+            {"name", "type 1, miINT8", [](const Mat5Tag& t) { return t.type == 1; }},
+        };
+        const auto where = [&](std::uint64_t off) {
+            return compressed ? fmt::format("{} (a compressed variable, byte {} of its decompressed data)", at, 8 + off)
+                              : std::to_string(at + 8 + off);
+        };
+        std::uint64_t off = 0;
+        bool sparse = false;  // its dimensions may exceed its data
+        for (int i = 0; i < 3; ++i) {
+            const Part& part = kParts[i];
+            if (off + 8 > have) return;  // not read here: libmatio's own checks follow
+            const Mat5Tag t = tag(body + off);
+            if (!part.valid(t))
+                throw InputError(name_, fmt::format("byte offset {}: the {} of a variable have a damaged tag (type {}, "
+                                                    "{} bytes; {} expected): the file is damaged",
+                                                    where(off), part.name, t.type, t.bytes, part.expected));
+            const std::uint64_t end = off + (t.small ? 8 : 8 + std::uint64_t{t.bytes});
+            if (end > declared)
+                throw InputError(name_, fmt::format("byte offset {}: the {} of a variable declare {} bytes, more than "
+                                                    "the {} bytes of its matrix element: the file is damaged",
+                                                    where(off), part.name, t.bytes, declared));
+            if (i == 0) {
+                if (have < 16) return;
+                // The class, the low byte of the flags. An object (17, mxOPAQUE) has no
+                // dimensions: a name and class names follow its flags, left to libmatio.
+                const std::uint32_t cls = word(body + 8) & 0xFF;
+                if (cls == 17) return;
+                sparse = cls == 5;
+            } else if (i == 1 && !sparse && end <= have) {
+                // Every element of a dense array, cell or struct takes at least a byte of
+                // the matrix element (libmatio sized allocations by the dimensions: 4 x
+                // 687 865 860 in a 320-byte file, fuzz/seeds/regress-damaged-dims-count.mat).
+                double elements = 1;
+                for (std::uint64_t d = 0; d < t.bytes / 4; ++d) elements *= static_cast<double>(word(body + off + 8 + 4 * d));
+                if (elements > static_cast<double>(declared))
+                    throw InputError(name_, fmt::format("byte offset {}: the dimensions of a variable hold {:.0f} "
+                                                        "elements, more than the {} bytes of its matrix element: the "
+                                                        "file is damaged",
+                                                        where(off), elements, declared));
+            }
+            off += t.padded();
+        }
+    }
+
+    void check_file(std::ifstream& in, std::uint64_t size) const {
+        std::uint64_t at = 128;
+        std::vector<unsigned char> body;
+        while (at + 8 <= size) {
+            unsigned char raw[8];
+            in.seekg(static_cast<std::streamoff>(at));
+            if (!in.read(reinterpret_cast<char*>(raw), 8)) return;
+            const Mat5Tag t = tag(raw);
+            if (t.small) {
+                at += 8;
+                continue;
+            }
+            if (t.bytes > size - at - 8)
+                throw InputError(name_, fmt::format("byte offset {}: a data element declares {} bytes, but only {} "
+                                                    "follow its tag: the file is cut short or damaged",
+                                                    at, t.bytes, size - at - 8));
+            if (t.type == kMiMatrix || t.type == kMiCompressed) {
+                body.resize(std::min<std::size_t>(t.bytes, 4096));
+                if (!in.read(reinterpret_cast<char*>(body.data()), static_cast<std::streamsize>(body.size()))) return;
+                if (t.type == kMiMatrix) check_matrix(at, body.data(), body.size(), t.bytes, false);
+                else check_compressed(at, body, t.bytes);
+            }
+            at += 8 + std::uint64_t{t.bytes};  // top-level elements are not padded
+        }
+    }
+
+private:
+    // A compressed element at byte offset `at` of `bytes` compressed bytes, the first of
+    // which are in `z`: the tag and matrix header of the element it holds.
+    void check_compressed(std::uint64_t at, const std::vector<unsigned char>& z, std::uint64_t bytes) const {
+        unsigned char out[512];
+        z_stream zs{};
+        if (inflateInit(&zs) != Z_OK) return;
+        zs.next_in = const_cast<unsigned char*>(z.data());
+        zs.avail_in = static_cast<uInt>(z.size());
+        zs.next_out = out;
+        zs.avail_out = sizeof out;
+        // What inflates before any error in the stream: libmatio reads a header out of a
+        // stream damaged after it (fuzz_mat: dimensions of 1.9 GB, then bad deflate data),
+        // and reports the damage itself.
+        inflate(&zs, Z_SYNC_FLUSH);
+        const std::size_t have = sizeof out - zs.avail_out;
+        inflateEnd(&zs);
+        if (have < 8) return;
+        const Mat5Tag inner = tag(out);
+        if (inner.small || inner.type != kMiMatrix) return;
+        const std::uint64_t limit = kMaxInflation * bytes + 65536;
+        if (inner.bytes > limit)
+            throw InputError(name_, fmt::format("byte offset {}: a compressed variable declares {} bytes, more than its "
+                                                "{} compressed bytes can hold: the file is damaged",
+                                                at, inner.bytes, bytes));
+        check_matrix(at, out + 8, have - 8, inner.bytes, true);
+    }
+
+    const std::string& name_;
+    bool little_;
+};
+
+// Checks a MAT-file before libmatio opens it: the 128-byte header of a Level 5 (MATLAB 5
+// and later) or 7.3 file, then, for Level 5, the element tags (InputError for one out of
+// form or declaring more than its file or element holds). A file without that header is
+// refused: libmatio would take it for a Level 4 file, whose header's name length it
+// allocates before reading (fuzz_mat: 1.7 GB filled for a 357-byte file).
+void check_mat_file(const std::string& name, std::uint64_t size) {
+    std::ifstream in(name, std::ios::binary);
+    unsigned char head[128];
+    if (!in || !in.read(reinterpret_cast<char*>(head), sizeof head))
+        throw InputError(name, fmt::format("{} bytes, shorter than the 128-byte header of a MAT-file", size));
+    // Bytes 126-127, the endian indicator: "IM" written little-endian, "MI" big-endian;
+    // bytes 124-125: the version, 0x0100 for Level 5, 0x0200 for 7.3 (HDF5 inside).
+    const bool little = head[126] == 'I' && head[127] == 'M';
+    const bool big = head[126] == 'M' && head[127] == 'I';
+    const unsigned version = little ? head[124] | head[125] << 8 : head[125] | head[124] << 8;
+    if ((!little && !big) || (version != 0x0100 && version != 0x0200))
+        throw InputError(name, fmt::format("bytes 124-127 hold no MAT-file version (0x0100 or 0x0200) and endian "
+                                           "indicator ('IM' or 'MI'): not a MAT-file of MATLAB 5 or later (Level 4 "
+                                           "MAT-files are not read)"));
+    if (version == 0x0100) Mat5Walk(name, little).check_file(in, size);
+}
+
 // Column `c` (0-based) of the rows x 4 column-major data of `v`, as T.
 template <class Fn>
 void each_value(const matvar_t* v, std::size_t rows, int c, Fn&& fn) {
@@ -123,6 +316,7 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
                          "a MATLAB .mat file is read by libmatio from a regular file; a pipe or standard input "
                          "cannot be read as .mat (save it to a file first)");
     file_size_ = static_cast<std::uint64_t>(st.st_size);
+    check_mat_file(path, *file_size_);
     init_matio_log(name_);
     g_matio_message.clear();
     MatPtr mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
