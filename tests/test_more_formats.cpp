@@ -679,6 +679,14 @@ TEST(Mat, DamagedTagsAreRefusedAtTheirByteOffset) {
     EXPECT_NE(w.find("byte offset 128 (a compressed variable, byte 24 of its decompressed data): the dimensions"),
               std::string::npos)
         << w;
+    // A compressed element declaring fewer bytes than its stream: libmatio inflates on past
+    // its end, so the header is checked there too.
+    std::string overrun = deflated(mat5_matrix(0xFFFF0008u));
+    overrun.replace(4, 4, le32(5));
+    w = refusal(write("overrun-z.mat", mat5_file(overrun)));
+    EXPECT_NE(w.find("byte offset 128 (a compressed variable, byte 24 of its decompressed data): the dimensions"),
+              std::string::npos)
+        << w;
     // A compressed element whose matrix declares more than its compressed bytes can hold.
     std::string big = mat5_matrix(8);
     big.replace(4, 4, le32(0x7FFFFFF0u));
@@ -704,6 +712,9 @@ TEST(Mat, DamagedTagsAreRefusedAtTheirByteOffset) {
         // which libmatio sized allocations by.
         {"rows.mat", 8, 32, 1000000000u,
          "byte offset 152: the dimensions of a variable hold 4000000000 elements, more than the 80 bytes"},
+        // An object (class 17, laid out otherwise) whose "dimensions" declare 4 GiB, which
+        // libmatio reads there all the same (a 2 GB allocation).
+        {"object.mat", 0xFFFF0008u, 16, 17, "byte offset 152: the dimensions of a variable declare 4294901768 bytes"},
     };
     for (const Damage& d : damages) {
         std::string m = mat5_matrix(d.dims_bytes);
