@@ -104,17 +104,17 @@ std::string describe(const matvar_t* v) {
 // - array flags with a damaged tag, then a name tag declaring 3.3 GB: 3.3 GB of memory
 //   filled for a 325-byte file (fuzz_mat, fuzz/seeds/regress-damaged-flags.mat);
 // - an uncompressed variable missing its last bytes read them as zeros (a time of 0).
-// So the element
-// tags of a MAT 5 file are walked here first (the MAT-File Format's Level 5 layout: a
-// 128-byte header, then data elements, each an 8-byte tag of type and byte count, or a
-// 4-byte "small element" tag when the count's half of the first word is not zero; a matrix
+// So the element tags of a MAT 5 file are walked here first (the MAT-File Format's Level 5
+// layout: a 128-byte header, then data elements, each an 8-byte tag of type and byte count,
+// or a 4-byte "small element" tag when the count's half of the first word is not zero; a matrix
 // opens with its array flags, dimensions and name sub-elements; a compressed element is a
 // zlib stream holding one such element). MAT 7.3 files (HDF5 inside) are not walked, and
 // Level 4 files are refused (check_mat_file()).
 constexpr std::uint32_t kMiMatrix = 14;
 constexpr std::uint32_t kMiCompressed = 15;
-// Deflate expands at most 1032:1 (as for the declared data below).
-constexpr std::uint64_t kMaxInflation = 1032;
+// The most data `compressed` bytes can hold: deflate expands at most 1032:1 (zlib's
+// bound), with 64 KiB of slack. Shared by the tag walk and the variable's declared data.
+double most_inflated(double compressed) noexcept { return 1032.0 * compressed + 65536.0; }
 
 struct Mat5Tag {
     std::uint32_t type;
@@ -259,8 +259,7 @@ private:
         if (have < 8) return;
         const Mat5Tag inner = tag(out);
         if (inner.small || inner.type != kMiMatrix) return;
-        const std::uint64_t limit = kMaxInflation * bytes + 65536;
-        if (inner.bytes > limit)
+        if (static_cast<double>(inner.bytes) > most_inflated(static_cast<double>(bytes)))
             throw InputError(name_, fmt::format("byte offset {}: a compressed variable declares {} bytes, more than its "
                                                 "{} compressed bytes can hold: the file is damaged",
                                                 at, inner.bytes, bytes));
@@ -287,9 +286,8 @@ void check_mat_file(const std::string& name, std::uint64_t size) {
     const bool big = head[126] == 'M' && head[127] == 'I';
     const unsigned version = little ? head[124] | head[125] << 8 : head[125] | head[124] << 8;
     if ((!little && !big) || (version != 0x0100 && version != 0x0200))
-        throw InputError(name, fmt::format("bytes 124-127 hold no MAT-file version (0x0100 or 0x0200) and endian "
-                                           "indicator ('IM' or 'MI'): not a MAT-file of MATLAB 5 or later (Level 4 "
-                                           "MAT-files are not read)"));
+        throw InputError(name, "bytes 124-127 hold no MAT-file version (0x0100 or 0x0200) and endian indicator "
+                               "('IM' or 'MI'): not a MAT-file of MATLAB 5 or later (Level 4 MAT-files are not read)");
     if (version == 0x0100) Mat5Walk(name, little).check_file(in, size);
 }
 
@@ -389,8 +387,7 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
     if (VarPtr info{Mat_VarReadInfo(mat.get(), var_.c_str())}) {
         double declared = static_cast<double>(Mat_SizeOfClass(info->class_type));
         for (int d = 0; d < info->rank && info->dims; ++d) declared *= static_cast<double>(info->dims[d]);
-        const double limit = 1032.0 * static_cast<double>(file_size_.value_or(0)) + 65536.0;
-        if (declared > limit)
+        if (declared > most_inflated(static_cast<double>(file_size_.value_or(0))))
             throw InputError(name_, fmt::format("variable {} declares {:.0f} bytes of data, more than this {}-byte "
                                                 "file can hold even compressed: the file is damaged",
                                                 describe(info.get()), declared, file_size_.value_or(0)));
