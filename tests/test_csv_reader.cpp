@@ -59,6 +59,60 @@ TEST(CsvReader, NanosecondsRoundToMicroseconds) {
     EXPECT_EQ(r.events[1].t, 7);
 }
 
+// The float-time rule: without --time-unit the first time decides (a decimal point:
+// seconds; none: microseconds); with one, every time is in it.
+TEST(CsvReader, FloatTimesAreSecondsUnlessTheUnitIsGiven) {
+    TempDir tmp;
+    const auto read_t = [&](const std::string& text, const std::string& unit) {
+        io::ReaderOptions o;
+        o.csv_time_unit = unit;
+        io::CsvReader reader(tmp.write("f.csv", text), o);
+        const ReadResult r = read_all(reader);
+        EXPECT_FALSE(r.failed) << text << " -> " << r.error;
+        std::vector<std::int64_t> t;
+        for (const Event& e : r.events) t.push_back(e.t);
+        return t;
+    };
+    using T = std::vector<std::int64_t>;
+    EXPECT_EQ(read_t("0.1,10,10,1\n0.25,10,10,1\n1,10,10,0\n", ""), (T{100'000, 250'000, 1'000'000}));
+    EXPECT_EQ(read_t("0.1 , 10,10,1\n", ""), (T{100'000}));  // as the same line with spaces
+    EXPECT_EQ(read_t("100,10,10,1\n250,10,10,1\n", ""), (T{100, 250}));
+    EXPECT_EQ(read_t("0.000001499,1,1,1\n0.0000015,1,1,1\n", ""), (T{1, 2}));  // nearest us
+    EXPECT_EQ(read_t("100,10,10,1\n", "s"), (T{100'000'000}));
+    EXPECT_EQ(read_t("1.5,10,10,1\n2.0015,10,10,1\n", "ms"), (T{1500, 2002}));
+    EXPECT_EQ(read_t("1499,10,10,1\n1500,10,10,1\n", "ns"), (T{1, 2}));
+}
+
+TEST(CsvReader, TimesTheRuleCannotReadAreErrors) {
+    TempDir tmp;
+    struct Case {
+        std::string text, unit;
+        std::uint64_t line;
+        std::string says;
+    };
+    const Case cases[] = {
+        {"100,1,1,1\n100.5,1,1,1\n", "", 2, "whose first time was an integer"},
+        {"0.1,1,1,1\n", "us", 1, "--time-unit is us"},
+        {"0.5,1,1,1\n", "us", 1, "--time-unit is us"},
+        {"1,1,1,1\n1.0000000001,1,1,1\n", "s", 2, "more than 9 decimals of a second"},
+        {"0.1,1,1,1\n0.2000000000001,1,1,1\n", "", 2, "more than 9 decimals of a second"},
+        {"1,1,1,1\n2.5,1,1,1\n", "ns", 2, "fraction of a nanosecond"},
+        {"1,1,1,1\n1e20,1,1,1\n", "", 2, "expected a timestamp"},
+        {"1,1,1,1\n9000000000000,1,1,1\n", "s", 2, "at most 9e12 seconds"},
+    };
+    for (const Case& c : cases) {
+        io::ReaderOptions o;
+        o.csv_time_unit = c.unit;
+        const auto path = tmp.write("e.csv", c.text);
+        io::CsvReader reader(path, o);
+        const ReadResult r = read_all(reader);
+        ASSERT_TRUE(r.failed) << c.text;
+        EXPECT_EQ(r.events.size(), c.line - 1) << c.text;
+        EXPECT_NE(r.error.find(path + ":" + std::to_string(c.line) + ": "), std::string::npos) << r.error;
+        EXPECT_NE(r.error.find(c.says), std::string::npos) << c.text << " -> " << r.error;
+    }
+}
+
 TEST(CsvReader, ErrorsNameTheLineAndKeepEventsBefore) {
     TempDir tmp;
     struct Case {

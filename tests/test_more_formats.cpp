@@ -374,6 +374,37 @@ TEST(NpyGeneral, StructuredFieldsByNameAnyOrderWidthAndByteOrder) {
     }
 }
 
+// A float time read in a unit of whole numbers (us, ns, given) with a fraction is an
+// error at the record, not a rounding: a fraction there means the times are in another unit.
+TEST(NpyGeneral, FractionalTimeInWholeUnitIsAnError) {
+    TempDir tmp;
+    std::string d;
+    for (const double t : {2.0, 3.0, 3.5}) {
+        put<double>(d, t);
+        put<double>(d, 1.0);
+        put<double>(d, 1.0);
+        put<double>(d, 1.0);
+    }
+    const std::string path = tmp.write("f.npy", npy_file("{'descr': '<f8', 'fortran_order': False, 'shape': (3, 4), }", d));
+    for (const std::string unit : {"us", "ns"}) {
+        io::ReaderOptions o;
+        o.csv_time_unit = unit;
+        auto r = io::open_event_reader(path, o);
+        const ReadResult res = read_all(*r);
+        ASSERT_TRUE(res.failed) << unit;
+        EXPECT_EQ(res.events.size(), 2u);
+        EXPECT_EQ(res.error_unit, InputError::Unit::byte);
+        EXPECT_NE(res.error.find("time 3.5 has a fraction, but --time-unit is " + unit), std::string::npos) << res.error;
+    }
+    io::ReaderOptions ms;
+    ms.csv_time_unit = "ms";  // a fraction of a millisecond is microseconds: read
+    auto r = io::open_event_reader(path, ms);
+    const ReadResult res = read_all(*r);
+    ASSERT_FALSE(res.failed) << res.error;
+    ASSERT_EQ(res.events.size(), 3u);
+    EXPECT_EQ(res.events[2].t, 3500);
+}
+
 TEST(NpyGeneral, PlainNBy4ArraysWithColumnNames) {
     TempDir tmp;
     std::string tx, xy;  // t,x,y,p (the default) and x,y,p,t orders

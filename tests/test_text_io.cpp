@@ -51,7 +51,7 @@ protected:
 TEST_F(TextIo, RoundsToTheNearestMicrosecond) {
     const auto ev = read(
         "0.000001 1 2 1\n"         // 1e-6 * 1e6 is not exactly 1 in binary floating point
-        "0.0000014999 1 2 1\n"     // just below a half: down
+        "0.000001499 1 2 1\n"      // just below a half: down
         "0.0000015 1 2 1\n"        // a half: up
         "43.499039001 1 2 1\n"     // 9 decimals as the dataset writes them
         "43.499039999 1 2 1\n"     // 999 ns: up to the next microsecond
@@ -63,6 +63,14 @@ TEST_F(TextIo, RoundsToTheNearestMicrosecond) {
     EXPECT_EQ(ev[3].t, 43'499'039);
     EXPECT_EQ(ev[4].t, 43'499'040);
     EXPECT_EQ(ev[5].t, 51'980'787);
+}
+
+TEST_F(TextIo, DigitsPastTheNinthDecimalMustBeZeros) {
+    // Zeros past the 9th decimal lose nothing; any other digit there is refused above.
+    const auto ev = read("0.000001500000 1 2 1\n8999999999999.999999999 1 2 1\n");
+    ASSERT_EQ(ev.size(), 2u);
+    EXPECT_EQ(ev[0].t, 2);
+    EXPECT_EQ(ev[1].t, 9'000'000'000'000'000'000);
 }
 
 TEST_F(TextIo, ShortDecimals) {
@@ -116,7 +124,9 @@ TEST_F(TextIo, EachKindOfError) {
         {"x 1 2 1\n", ":1:", "expected a timestamp"},
         {"0.1 1 2 1 7\n", ":1:", "unexpected text after the polarity"},
         {"0.1 70000 2 1\n", ":1:", "x does not fit 16 bits"},
-        {"1e-3 1 2 1\n", ":1:", "expected a space and x"},
+        {"1e-3 1 2 1\n", ":1:", "expected a timestamp in seconds"},
+        {"0.0000014999 1 2 1\n", ":1:", "more than 9 decimals of a second"},
+        {"9000000000000 1 2 1\n", ":1:", "at most 9e12 seconds"},
         {"\n\n0.1 1 2 1 junk\n", ":3:", "unexpected text"},
     };
     for (const Case& c : cases) {

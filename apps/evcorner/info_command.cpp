@@ -212,7 +212,8 @@ void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_colu
     cmd.add_option("--csv-columns", csv_columns,
                    "CSV column order, e.g. x,y,p,t ('_' skips a column) [default: the header row, else t,x,y,p]");
     cmd.add_option("--time-unit", time_unit,
-                   "Time unit: us, ns, ms or s [default: CSV and .mat us; .npy integers us, floats s]")
+                   "Time unit of CSV, .npy and .mat times: us, ns, ms or s [default: floats s, integers us; .mat us] "
+                   "(docs/formats.md, \"Times\")")
         ->check(CLI::IsMember({"us", "ns", "ms", "s"}));
     cmd.add_option("--chip", chip,
                    "AEDAT 2.0: the camera that recorded the file (DVS128, DAVIS240C, DAVIS346, ...), "

@@ -6,12 +6,11 @@
 #include <utility>
 
 #include "evcorner/error.hpp"
+#include "decimal_time.hpp"
 
 namespace evcorner::io {
 
 namespace {
-
-constexpr std::int64_t kPow10[] = {1, 10, 100, 1000, 10000, 100000, 1000000};
 
 inline bool is_space(char c) { return c == ' ' || c == '\t'; }
 inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
@@ -34,10 +33,11 @@ CsvReader::CsvReader(InputFile file, ReaderOptions options)
     if (const auto c = lines_.file().compression()) format_.append("+").append(compression_name(*c));  // not "+" + string: GCC 12 -Wrestrict false positive
     sensor_ = options_.sensor ? options_.sensor : options_.fallback_sensor;
     const std::string& u = options_.csv_time_unit;
-    if (u == "us" || u.empty()) time_digits_ = 0;
-    else if (u == "ms") time_digits_ = 3;
-    else if (u == "s") time_digits_ = 6;
-    else if (u == "ns") time_div_ = 1000;
+    unit_given_ = !u.empty();
+    if (u == "us" || u.empty()) time_unit_ = TimeUnit::us;
+    else if (u == "ms") time_unit_ = TimeUnit::ms;
+    else if (u == "s") time_unit_ = TimeUnit::s;
+    else if (u == "ns") time_unit_ = TimeUnit::ns;
     else throw InputError(lines_.file().name(), "unknown CSV time unit '" + u + "' (us, ns, ms or s)");
     if (!options_.csv_columns.empty()) set_columns(options_.csv_columns, false);
 }
@@ -72,7 +72,7 @@ void CsvReader::set_columns(const std::string& spec, bool from_header) {
     columns_known_ = true;
 }
 
-bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& why) const {
+bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& why) {
     std::size_t col = 0;
     for (;; ++col) {
         if (col >= columns_.size()) {
@@ -86,41 +86,29 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
         while (fe > f && is_space(fe[-1])) --fe;
         const Field kind = columns_[col];
         if (kind == kT) {
-            const char* q = f;
-            const bool neg = q < fe && *q == '-';
-            if (q < fe && (*q == '-' || *q == '+')) ++q;
-            std::int64_t ip = 0;
-            int digits = 0;
-            while (q < fe && is_digit(*q)) {
-                if (++digits > 18) {  // before the multiplication: 19 digits overflow int64
-                    why = "timestamp too large";
+            const bool has_point = std::memchr(f, '.', static_cast<std::size_t>(fe - f)) != nullptr;
+            TimeUnit unit = time_unit_;
+            bool whole = unit == TimeUnit::us;
+            if (!unit_given_) {
+                // The first time decides: with a decimal point seconds, else microseconds.
+                if (float_time_ == Tri::unknown) float_time_ = has_point ? Tri::yes : Tri::no;
+                if (float_time_ == Tri::yes) {
+                    unit = TimeUnit::s;
+                    whole = false;
+                } else if (has_point) {
+                    why = "a decimal point in a time column whose first time was an integer: times are "
+                          "microseconds when the first has no decimal point, else seconds (--time-unit sets the unit)";
                     return false;
                 }
-                ip = ip * 10 + (*q++ - '0');
             }
-            std::int64_t frac = 0;  // the first time_digits_ + 1 fractional digits
-            int fd = 0;
-            if (q < fe && *q == '.') {
-                ++q;
-                while (q < fe && is_digit(*q)) {
-                    if (fd <= time_digits_) frac = frac * 10 + (*q - '0');
-                    ++fd;
-                    ++q;
-                }
-            }
-            if (q != fe || (digits == 0 && fd == 0)) {
-                why = "expected a timestamp";
+            const detail::DecimalTime t = detail::parse_decimal_time(f, fe, unit, whole);
+            if (t.error != nullptr) {
+                why = whole && unit_given_ && has_point && t.error != detail::kNotATimestamp
+                          ? "a fraction of a microsecond, but --time-unit is us (whole microseconds)"
+                          : t.error;
                 return false;
             }
-            if (ip > INT64_MAX / kPow10[time_digits_] / 2) {
-                why = "timestamp too large";
-                return false;
-            }
-            for (int d = std::min(fd, time_digits_ + 1); d <= time_digits_; ++d) frac *= 10;
-            // frac now holds time_digits_ + 1 digits: the last one rounds (halves away from zero).
-            std::int64_t us = ip * kPow10[time_digits_] + frac / 10 + (frac % 10 >= 5 ? 1 : 0);
-            if (time_div_ > 1) us = (ip + time_div_ / 2) / time_div_;
-            ev.t = neg ? -us : us;
+            ev.t = t.us;
         } else if (kind == kX || kind == kY) {
             std::uint32_t v = 0;
             const char* q = f;

@@ -409,6 +409,7 @@ NpyReader::NpyReader(InputFile file, ReaderOptions options)
     time_scale_ = u == "s" ? 1e6 : u == "ms" ? 1e3 : u == "us" ? 1.0 : 1e-3;
     time_mul_ = u == "s" ? 1'000'000 : u == "ms" ? 1000 : 1;
     time_div_ = u == "ns" ? 1000 : 1;
+    whole_time_ = float_time && (unit == "us" || unit == "ns");
 
     if (const auto total = bytes_total()) {
         const std::uint64_t body = *total - offset();
@@ -500,10 +501,18 @@ bool NpyReader::decode_general() {
             std::int64_t* out = ct_.data();
             if constexpr (std::is_floating_point_v<T>) {
                 const double scale = time_scale_;
+                const bool whole = whole_time_;
                 for (std::size_t i = 0; i < records; ++i) {
-                    const double v = static_cast<double>(load<T>(q + i * stride, f.swap)) * scale;
+                    const double raw = static_cast<double>(load<T>(q + i * stride, f.swap));
+                    const double v = raw * scale;
                     if (!(std::fabs(v) < 9.2e18)) [[unlikely]] {
                         mark(i, 0, fmt::format("time {} is not a finite number in range", v));
+                        break;
+                    }
+                    if (whole && raw != static_cast<double>(static_cast<std::int64_t>(raw))) [[unlikely]] {
+                        mark(i, 0, fmt::format("time {} has a fraction, but --time-unit is {} (whole numbers: "
+                                               "a float time is seconds unless the unit is given)",
+                                               raw, this->options().csv_time_unit));
                         break;
                     }
                     out[i] = static_cast<std::int64_t>(v + (v >= 0 ? 0.5 : -0.5));  // nearest, halves away from zero

@@ -4,13 +4,11 @@
 #include <utility>
 
 #include "evcorner/error.hpp"
+#include "decimal_time.hpp"
 
 namespace evcorner::io {
 
 namespace {
-
-// |t| below this many seconds keeps t in microseconds far from int64 overflow.
-constexpr std::int64_t kMaxSeconds = 9'000'000'000'000;
 
 inline bool is_space(char c) { return c == ' ' || c == '\t'; }
 inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
@@ -25,30 +23,13 @@ Parsed parse_line(const char* p, const char* end) {
     Parsed r;
     while (p < end && is_space(*p)) ++p;
 
-    bool negative = false;
-    if (p < end && (*p == '-' || *p == '+')) negative = *p++ == '-';
-    std::int64_t sec = 0;
-    int int_digits = 0;
-    while (p < end && is_digit(*p)) {
-        sec = sec * 10 + (*p++ - '0');
-        if (++int_digits > 13) return {r.e, "timestamp too large"};
-    }
-    std::int64_t frac_ns = 0;
-    int frac_digits = 0;
-    if (p < end && *p == '.') {
-        ++p;
-        while (p < end && is_digit(*p)) {
-            if (frac_digits < 9) frac_ns = frac_ns * 10 + (*p - '0');
-            ++frac_digits;
-            ++p;
-        }
-    }
-    if (int_digits == 0 && frac_digits == 0) return {r.e, "expected a timestamp in seconds"};
-    if (sec >= kMaxSeconds) return {r.e, "timestamp too large"};
-    for (int d = frac_digits; d < 9; ++d) frac_ns *= 10;
-    // Nearest microsecond, halves away from zero; digits past the 9th cannot change it.
-    std::int64_t us = sec * 1'000'000 + frac_ns / 1000 + (frac_ns % 1000 >= 500 ? 1 : 0);
-    r.e.t = negative ? -us : us;
+    const char* t_end = p;
+    while (t_end < end && !is_space(*t_end)) ++t_end;
+    const detail::DecimalTime t = detail::parse_decimal_time(p, t_end, TimeUnit::s, false);
+    if (t.error != nullptr)
+        return {r.e, t.error == detail::kNotATimestamp ? "expected a timestamp in seconds" : t.error};
+    r.e.t = t.us;
+    p = t_end;
 
     std::uint32_t coord[2];
     for (int i = 0; i < 2; ++i) {

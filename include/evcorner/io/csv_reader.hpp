@@ -2,8 +2,9 @@
 // Reader for comma-separated event files: one event per line with the columns t, x, y,
 // p in the order ReaderOptions::csv_columns gives, or the file's header row names
 // (e.g. "x,y,p,t" as Metavision and tonic write; "timestamp", "ts", "polarity", "pol"
-// are recognised too), else t,x,y,p. t is in ReaderOptions::csv_time_unit (microseconds
-// by default; ns/ms/s are converted once, here, rounding to the nearest microsecond);
+// are recognised too), else t,x,y,p. t is in ReaderOptions::csv_time_unit; without one,
+// seconds when the first time has a decimal point, else microseconds (docs/formats.md,
+// "Times": rounding to the nearest microsecond, and the times refused);
 // p is 1 or 0 (-1 also means OFF). Spaces around fields, '#' comment lines, blank lines
 // and CRLF are accepted. Errors name the file and the 1-based line.
 
@@ -39,15 +40,17 @@ public:
 private:
     enum Field : std::uint8_t { kT, kX, kY, kP, kIgnore };
     void set_columns(const std::string& spec, bool from_header);
-    bool parse(const char* b, const char* e, Event& ev, const char*& why) const;
+    bool parse(const char* b, const char* e, Event& ev, const char*& why);
+    enum class Tri : std::uint8_t { unknown, no, yes };
 
     LineSource lines_;
     std::string format_;
     ReaderOptions options_;
     std::optional<SensorSize> sensor_;
     std::vector<Field> columns_;
-    int time_digits_ = 0;  // decimal digits of a microsecond in the time unit (s: 6, ms: 3, us: 0)
-    std::int64_t time_div_ = 1;  // ns: 1000
+    TimeUnit time_unit_ = TimeUnit::us;  // as given (csv_time_unit), else us
+    bool unit_given_ = false;
+    Tri float_time_ = Tri::unknown;  // without a unit given: whether the first time had a decimal point
     bool columns_known_ = false;
     bool seen_row_ = false;  // a header row may only come first
     std::int64_t last_t_ = INT64_MIN;

@@ -20,6 +20,9 @@
 
 namespace evcorner::io {
 
+/// The unit of a file's time values (ReaderOptions::csv_time_unit names one).
+enum class TimeUnit : std::uint8_t { ns, us, ms, s };
+
 struct ReaderOptions {
     /// Sensor size to validate events against; overrides the file's own metadata.
     std::optional<SensorSize> sensor;
@@ -37,9 +40,9 @@ struct ReaderOptions {
     /// "DAVIS240C", "DAVIS346", ...; see aedat2_reader.hpp), used instead of the header's
     /// "# AEChip:" line for the address layout and the sensor size. Empty: the header's.
     std::string aedat2_chip;
-    /// The unit of the time values: CSV's t column ("us" (integers), "ns", "ms" or "s"
-    /// (decimals)), and .npy / .mat time fields. Empty: the format's default (CSV: us;
-    /// .npy and .mat: integers us, floats s).
+    /// The unit of the time values ("us", "ns", "ms" or "s") of CSV's t column and .npy /
+    /// .mat time fields. Empty: the float-time rule (docs/formats.md, "Times"): floats are
+    /// seconds (CSV: the first time has a decimal point), integers microseconds (.mat: us).
     std::string csv_time_unit;
     /// .npy only: the meaning of the 4 columns of a plain (N, 4) array, e.g. "x,y,p,t"
     /// ("_" ignores one). Empty: "t,x,y,p".

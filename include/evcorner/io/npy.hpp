@@ -15,7 +15,8 @@
 //   ReaderOptions::npy_columns (default "t,x,y,p", the written layout's order).
 // Time: integers are microseconds, floats seconds, unless ReaderOptions::csv_time_unit
 // names the unit ("us", "ns", "ms", "s"); floats are rounded to the nearest microsecond
-// (halves away from zero).
+// (halves away from zero), but a float time with a fraction in a given unit of us or ns is
+// an error (docs/formats.md, "Times").
 // x and y must be integers 0..65535 (a float one must be integral); polarity 1 = ON,
 // 0 or -1 = OFF (or bool). The evcorner layout (and its packed 13-byte form, 'p' as bool)
 // is read by a copying fast path; every other layout converts each field column-wise.
@@ -79,6 +80,7 @@ private:
     Field fields_[4];         // t, x, y, p
     double time_scale_ = 1;   // float time * scale = us
     std::int64_t time_mul_ = 1, time_div_ = 1;  // integer time * mul / div = us
+    bool whole_time_ = false;  // float times in us or ns (given): a fraction is an error
     // Column-wise conversion buffers of decode_general().
     std::vector<std::int64_t> ct_;
     std::vector<std::uint32_t> cx_, cy_, cp_;

@@ -1,7 +1,8 @@
 #pragma once
 // Streaming reader for the Event-Camera-Dataset text format (Mueggler et al., IJRR 2017):
-// one event per line, "t x y p", t in seconds (up to 9 decimals read exactly; more are
-// allowed), x and y pixel coordinates, p = 1 (ON) or 0 (OFF), separated by spaces or tabs.
+// one event per line, "t x y p", t in seconds (up to 9 decimals read exactly; a nonzero
+// digit past the 9th is an error: docs/formats.md, "Times"), x and y pixel coordinates,
+// p = 1 (ON) or 0 (OFF), separated by spaces or tabs.
 // Blank lines and lines starting with '#' are skipped; CRLF line ends are accepted.
 //
 // Time is rounded to the nearest microsecond (halves away from zero) with integer

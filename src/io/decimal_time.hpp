@@ -1,0 +1,89 @@
+#pragma once
+// A decimal time field of a text format ("12", "-0.5", "43.499039001") in a unit, to
+// integer microseconds: the one float-time rule of the text readers (docs/formats.md,
+// "Times"). Digits are read exactly (no binary floating point); the value is rounded to
+// the nearest microsecond, halves away from zero. Refused, with a reason:
+// - a nonzero digit finer than a nanosecond (more than 9 decimals of a second, 6 of a
+//   millisecond, 3 of a microsecond, any fraction of a nanosecond): precision the
+//   microsecond clock cannot keep, whose silent rounding would hide a unit mistake;
+// - with `whole_only`, any nonzero fraction (a time column in microseconds holds whole
+//   numbers: a fraction means the values are in another unit);
+// - a value of |t| >= 9e12 seconds (about 285 000 years: microseconds far from int64's end).
+
+#include <cstdint>
+
+#include "evcorner/io/event_reader.hpp"
+
+namespace evcorner::io::detail {
+
+/// Decimal digits of a microsecond in `u`'s fraction (s: 6, ms: 3, us: 0, ns: -3).
+constexpr int us_digits(TimeUnit u) noexcept {
+    return u == TimeUnit::s ? 6 : u == TimeUnit::ms ? 3 : u == TimeUnit::us ? 0 : -3;
+}
+
+/// The reason given for text that is not a number at all (callers may say more).
+inline constexpr const char* kNotATimestamp = "expected a timestamp";
+
+struct DecimalTime {
+    std::int64_t us = 0;
+    bool has_point = false;       ///< the text had a decimal point
+    const char* error = nullptr;  ///< why the text is refused, or nullptr
+};
+
+/// Parses [b, e) (no surrounding spaces) as an optionally signed decimal in `unit`.
+inline DecimalTime parse_decimal_time(const char* b, const char* e, TimeUnit unit, bool whole_only) noexcept {
+    DecimalTime r;
+    const auto is_digit = [](char c) { return static_cast<unsigned char>(c - '0') < 10; };
+    bool negative = false;
+    if (b < e && (*b == '-' || *b == '+')) negative = *b++ == '-';
+    // The integer part in the unit, and the fraction in nanoseconds: no overflow and no
+    // floating point.
+    std::int64_t ip = 0;
+    int int_digits = 0;
+    while (b < e && is_digit(*b)) {
+        if (++int_digits > 18) return {0, false, "timestamp too large (at most 9e12 seconds)"};
+        ip = ip * 10 + (*b++ - '0');
+    }
+    const int ns_digits = us_digits(unit) + 3;  // fraction digits down to a nanosecond
+    std::int64_t frac_ns = 0;                   // the fraction in nanoseconds (ns_digits digits)
+    int frac_digits = 0;
+    bool frac_nonzero = false;
+    if (b < e && *b == '.') {
+        r.has_point = true;
+        ++b;
+        while (b < e && is_digit(*b)) {
+            const int d = *b - '0';
+            if (d != 0) {
+                frac_nonzero = true;
+                if (frac_digits >= ns_digits)
+                    return {0, true, "a time given to a fraction of a nanosecond (more than 9 decimals of a second)"};
+            }
+            if (frac_digits < ns_digits) frac_ns = frac_ns * 10 + d;
+            ++frac_digits;
+            ++b;
+        }
+    }
+    if (b != e || (int_digits == 0 && frac_digits == 0)) return {0, r.has_point, kNotATimestamp};
+    if (whole_only && frac_nonzero)
+        return {0, true, "a fraction of a microsecond in a time column of whole microseconds"};
+    for (int d = frac_digits; d < ns_digits; ++d) frac_ns *= 10;
+    constexpr std::int64_t kMaxUs = 9'000'000'000'000LL * 1'000'000;  // 9e12 s
+    std::int64_t scale_ns = 1;  // nanoseconds in one unit
+    for (int d = 0; d < ns_digits; ++d) scale_ns *= 10;
+    if (scale_ns >= 1000 && ip >= kMaxUs / (scale_ns / 1000))
+        return {0, r.has_point, "timestamp too large (at most 9e12 seconds)"};
+    // Microseconds: ip * scale_ns / 1000 + frac_ns / 1000, rounded on the nanoseconds.
+    std::int64_t whole_us, rem_ns;
+    if (scale_ns >= 1000) {
+        whole_us = ip * (scale_ns / 1000) + frac_ns / 1000;
+        rem_ns = frac_ns % 1000;
+    } else {  // ns: the integer part is nanoseconds
+        whole_us = ip / 1000;
+        rem_ns = ip % 1000;
+    }
+    const std::int64_t us = whole_us + (rem_ns >= 500 ? 1 : 0);
+    r.us = negative ? -us : us;
+    return r;
+}
+
+}  // namespace evcorner::io::detail
