@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
+#include <stdexcept>
 #include <sstream>
 
 #include "evcorner/io/event_writer.hpp"
@@ -79,6 +81,84 @@ TEST(Writers, CraftedEdgeValuesRoundTrip) {
         w->write(events);
         w->close();
         EXPECT_EQ(read_file(out), events) << ext;
+    }
+}
+
+// Every writer that carries scores gives them back through its reader, exactly, in
+// batches of any size; events outside a given sensor are skipped with their scores.
+TEST(Writers, ScoresRoundTripThroughEveryScoredWriter) {
+    TempDir tmp;
+    std::vector<Event> events;
+    std::vector<double> scores;
+    for (int i = 0; i < 3000; ++i) {
+        events.push_back({i * 7 - 50, static_cast<std::uint16_t>(i % 300), static_cast<std::uint16_t>(i % 170),
+                          static_cast<std::uint8_t>(i % 2)});
+        scores.push_back(i % 5 == 0 ? -0.0 : (i - 1500) * 1.2345678901234567e-3 * (i % 3 ? 1e-200 : 1e200));
+    }
+    scores[7] = std::numeric_limits<double>::infinity();
+    for (const char* ext : {"txt", "csv", "npy", "h5"}) {
+        SCOPED_TRACE(ext);
+        const auto out = tmp.path(std::string("s.") + ext);
+        {
+            auto w = io::open_event_writer(out, "auto", SensorSize{300, 170}, true);
+            EXPECT_THROW(w->write(std::span<const Event>(events.data(), 1)), std::logic_error);
+            w->write(std::span<const Event>(events.data(), 1000), std::span<const double>(scores.data(), 1000));
+            w->write(std::span<const Event>(events.data() + 1000, 2000), std::span<const double>(scores.data() + 1000, 2000));
+            w->close();
+        }
+        for (const std::size_t batch : {std::size_t{1}, std::size_t{777}, std::size_t{1} << 16}) {
+            io::ReaderOptions o;
+            o.fallback_sensor = std::nullopt;
+            auto r = io::open_event_reader(out, o);
+            std::vector<Event> ev_back;
+            std::vector<double> sc_back;
+            std::vector<Event> buf(batch);
+            for (;;) {
+                const std::size_t n = r->read(buf);
+                if (n == 0 && r->skipped_in_batch().empty()) break;
+                ASSERT_EQ(r->scores_in_batch().size(), n);
+                ev_back.insert(ev_back.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
+                sc_back.insert(sc_back.end(), r->scores_in_batch().begin(), r->scores_in_batch().end());
+            }
+            EXPECT_EQ(ev_back, events);
+            ASSERT_EQ(sc_back.size(), scores.size());
+            for (std::size_t i = 0; i < scores.size(); ++i)
+                ASSERT_EQ(std::memcmp(&sc_back[i], &scores[i], 8), 0) << i << ": " << sc_back[i] << " vs " << scores[i];
+        }
+        // With a smaller sensor the events outside it are skipped, their scores too.
+        io::ReaderOptions small;
+        small.sensor = SensorSize{100, 170};
+        small.skip_invalid = true;
+        auto r = io::open_event_reader(out, small);
+        std::vector<Event> buf(500);
+        for (;;) {
+            const std::size_t n = r->read(buf);
+            if (n == 0 && r->skipped_in_batch().empty()) break;
+            ASSERT_EQ(r->scores_in_batch().size(), n);
+            for (std::size_t i = 0; i < n; ++i) {
+                const std::size_t k = static_cast<std::size_t>((buf[i].t + 50) / 7);
+                ASSERT_LT(buf[i].x, 100);
+                ASSERT_EQ(std::memcmp(&r->scores_in_batch()[i], &scores[k], 8), 0) << k;
+            }
+        }
+    }
+    // A file without scores gives none; AEDAT 4.0 has no field for them.
+    const auto plain = tmp.path("plain.csv");
+    {
+        auto w = io::open_event_writer(plain);
+        w->write(events);
+        EXPECT_THROW(w->write(events, scores), std::logic_error);
+        w->close();
+    }
+    auto r = io::open_event_reader(plain);
+    std::vector<Event> buf(100);
+    EXPECT_EQ(r->read(buf), 100u);
+    EXPECT_TRUE(r->scores_in_batch().empty());
+    try {
+        io::open_event_writer(tmp.path("s.aedat4"), "auto", std::nullopt, true);
+        ADD_FAILURE() << "aedat4 with scores accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("no field for a score"), std::string::npos) << e.what();
     }
 }
 

@@ -204,8 +204,9 @@ void add_detect_command(CLI::App& app) {
                     "reduction_rate [%], ns_per_event). No two outputs may share a file or both be - "
                     "(standard output), and none may be the input");
     cmd->add_flag("--with-score", o->run.with_score,
-                  "Append the detector's score to each corner line ('t x y p score'); detectors with a score: " +
-                      scored);
+                  "Write each corner's score with it: text 't x y p score', CSV and .npy a score column, HDF5 "
+                  "events/score (not AEDAT 4.0); label, render and the readers read it back. Detectors "
+                  "with a score: " + scored);
     add_nms_options(*cmd, o->nms, o->nms_params, o->nms_rule);
     add_param_options(*cmd, o->run.detector.params);
     cmd->add_option("-j,--threads", o->run.threads,

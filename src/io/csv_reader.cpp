@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cstring>
 #include <utility>
 
@@ -54,10 +55,14 @@ void CsvReader::set_columns(const std::string& spec, bool from_header) {
         else if (name == "x") f = kX;
         else if (name == "y") f = kY;
         else if (name == "p" || name == "pol" || name == "polarity") f = kP;
+        else if (name == "score") f = kScore;
         else if (!from_header && name != "_")
             throw InputError(lines_.file().name(), "unknown CSV column " + quote_bytes(name) + " in " + quote_bytes(spec) +
-                                               " (t, x, y, p, or _ to ignore one)");
-        if (f != kIgnore && seen[f]++ > 0)
+                                               " (t, x, y, p, score, or _ to ignore one)");
+        if (f == kScore && has_score_)
+            throw InputError(lines_.file().name(), "CSV column " + quote_bytes(name) + " named twice in " + quote_bytes(spec));
+        if (f == kScore) has_score_ = true;
+        if (f < kIgnore && seen[f]++ > 0)
             throw InputError(lines_.file().name(), "CSV column " + quote_bytes(name) + " named twice in " + quote_bytes(spec));
         cols.push_back(f);
         if (comma == std::string::npos) break;
@@ -123,6 +128,12 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
                 }
             }
             (kind == kX ? ev.x : ev.y) = static_cast<std::uint16_t>(v);
+        } else if (kind == kScore) {
+            const auto res = std::from_chars(f, fe, score_);
+            if (res.ec != std::errc() || res.ptr != fe || f == fe) {
+                why = "expected a score, a number";
+                return false;
+            }
         } else if (kind == kP) {
             const std::size_t len = static_cast<std::size_t>(fe - f);
             if (len == 1 && (*f == '0' || *f == '1')) ev.p = static_cast<std::uint8_t>(*f - '0');
@@ -146,6 +157,7 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
 
 std::size_t CsvReader::read(std::span<Event> out) {
     skips_.new_batch();
+    batch_n_ = 0;
     if (error_) std::rethrow_exception(error_);
     std::size_t n = 0;
     try {
@@ -174,12 +186,17 @@ std::size_t CsvReader::read(std::span<Event> out) {
                 continue;
             }
             last_t_ = ev.t;
+            if (has_score_) {
+                if (scores_.size() < out.size()) scores_.resize(out.size());
+                scores_[n] = score_;
+            }
             out[n++] = ev;
         }
     } catch (const InputError&) {
         error_ = std::current_exception();
         if (n == 0 && skips_.batch().empty()) throw;
     }
+    batch_n_ = n;
     return n;
 }
 

@@ -15,13 +15,22 @@ namespace {
 
 class TextEventWriter final : public EventWriter {
 public:
-    explicit TextEventWriter(std::string path) : w_(std::move(path)) {}
-    void write(std::span<const Event> events) override { w_.write(events); }
+    TextEventWriter(std::string path, bool with_score) : w_(std::move(path)), with_score_(with_score) {}
+    void write(std::span<const Event> events) override {
+        if (with_score_) throw std::logic_error("TextEventWriter: opened with scores, written without");
+        w_.write(events);
+    }
+    void write(std::span<const Event> events, std::span<const double> scores) override {
+        if (!with_score_ || scores.size() != events.size())
+            throw std::logic_error("TextEventWriter: scores on a writer opened without, or not one per event");
+        for (std::size_t i = 0; i < events.size(); ++i) w_.write(events[i], scores[i]);
+    }
     void close() override { w_.close(); }
     [[nodiscard]] const std::string& name() const noexcept override { return w_.name(); }
 
 private:
     TextWriter w_;
+    bool with_score_;
 };
 
 bool ends_with(const std::string& s, std::string_view suffix) {
@@ -65,12 +74,19 @@ std::string resolve_output_format(const std::string& path, std::string_view form
                                 std::string(kOutputFormats) + ")");
 }
 
+void EventWriter::write(std::span<const Event> /*events*/, std::span<const double> /*scores*/) {
+    throw std::logic_error("EventWriter: this writer was not opened with scores");
+}
+
 std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format,
-                                               std::optional<SensorSize> sensor) {
+                                               std::optional<SensorSize> sensor, bool with_score) {
     const std::string f = resolve_output_format(path, format);
-    if (f == "ecd-text") return std::make_unique<TextEventWriter>(path);
-    if (f == "csv") return std::make_unique<CsvWriter>(path);
-    if (f == "npy") return std::make_unique<NpyWriter>(path);
+    if (f == "ecd-text") return std::make_unique<TextEventWriter>(path, with_score);
+    if (f == "csv") return std::make_unique<CsvWriter>(path, with_score);
+    if (f == "npy") return std::make_unique<NpyWriter>(path, with_score);
+    if (with_score && f == "aedat4")
+        throw std::invalid_argument("output " + path + ": AEDAT 4.0 event packets have no field for a score "
+                                    "(formats that carry scores: " + std::string(kScoredOutputFormats) + ")");
     if (f == "aedat4") {
         Aedat4Writer::Options o;
         o.sensor = sensor;
@@ -78,6 +94,7 @@ std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::str
     }
     Hdf5Writer::Options o;
     o.sensor = sensor;
+    o.with_score = with_score;
     return std::make_unique<Hdf5Writer>(path, o);
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <stdexcept>
 #include <cstring>
 #include <fmt/format.h>
 #include <utility>
@@ -38,7 +39,7 @@ namespace {
 #define EVCORNER_HDF5_GLOBALS(X)                                                                                 \
     X(H5T_NATIVE_DOUBLE_g) X(H5T_NATIVE_INT_g) X(H5T_NATIVE_INT32_g) X(H5T_NATIVE_INT64_g)                        \
     X(H5T_NATIVE_UINT16_g) X(H5T_NATIVE_UINT8_g) X(H5T_STD_I32LE_g) X(H5T_STD_I64LE_g) X(H5T_STD_U16LE_g)        \
-    X(H5T_STD_U8LE_g) X(H5P_CLS_DATASET_CREATE_ID_g)
+    X(H5T_STD_U8LE_g) X(H5T_IEEE_F64LE_g) X(H5P_CLS_DATASET_CREATE_ID_g)
 
 struct Hdf5Api {
 #define EVCORNER_FIELD(name) decltype(&::name) name = nullptr;
@@ -184,6 +185,7 @@ std::optional<std::uint64_t> regular_file_size(const std::string& path) {
 struct Hdf5Reader::Impl {
     Hid file;
     Hid dset[4];  // x, y, t, p
+    Hid score;    // events/score, when the file has one
     const char* names[4] = {};
     bool t_float = false;
     bool p_enum = false;
@@ -272,6 +274,19 @@ Hdf5Reader::Hdf5Reader(std::string path, ReaderOptions options)
             hsize_t c = 0;
             if (H5Pget_chunk(dcpl.get(), 1, &c) == 1) impl_->chunk = c;
         }
+    }
+    // events/score (corner files written with scores): one number per event.
+    if (layout_ == Layout::dsec && link_exists(f, "events/score")) {
+        impl_->score = Hid(quiet([&] { return H5Dopen2(f, "events/score", H5P_DEFAULT); }), H5Dclose);
+        Hid space(impl_->score.ok() ? H5Dget_space(impl_->score.get()) : H5I_INVALID_HID, H5Sclose);
+        Hid type(impl_->score.ok() ? H5Dget_type(impl_->score.get()) : H5I_INVALID_HID, H5Tclose);
+        hsize_t dims[2] = {0, 0};
+        const H5T_class_t cls = type.ok() ? H5Tget_class(type.get()) : H5T_NO_CLASS;
+        if (!space.ok() || quiet([&] { return H5Sget_simple_extent_ndims(space.get()); }) != 1 ||
+            quiet([&] { return H5Sget_simple_extent_dims(space.get(), dims, nullptr); }) != 1 || dims[0] != total_ ||
+            (cls != H5T_INTEGER && cls != H5T_FLOAT))
+            throw InputError(name_, fmt::format("dataset events/score is not {} numbers, one per event", total_));
+        has_score_ = true;
     }
     // t_offset (DSEC): a scalar integer dataset at the root.
     if (layout_ == Layout::dsec && link_exists(f, "t_offset")) {
@@ -383,6 +398,15 @@ void Hdf5Reader::load_chunk() {
             fail_at(chunk_start_, i,
                     "HDF5 cannot read these events (damaged data, or a filter that fails): " + hdf5_reason(errno));
     }
+    if (has_score_) {
+        s_.resize(kChunk);
+        Hid space(H5Dget_space(impl_->score.get()), H5Sclose);
+        if (!space.ok() ||
+            quiet([&] { return H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr); }) < 0 ||
+            quiet([&] { return H5Dread(impl_->score.get(), H5T_NATIVE_DOUBLE, mem.get(), space.get(), H5P_DEFAULT, s_.data()); }) < 0)
+            throw InputError(name_, fmt::format("events/score: HDF5 cannot read the scores of events {} to {}: {}",
+                                                chunk_start_, chunk_start_ + chunk_n_ - 1, hdf5_reason(errno)));
+    }
     if (impl_->t_float) {
         for (std::size_t k = 0; k < chunk_n_; ++k) {
             const double us = ts_[k] * 1e6;
@@ -400,7 +424,9 @@ void Hdf5Reader::load_chunk() {
 
 std::size_t Hdf5Reader::read(std::span<Event> out) {
     skips_.new_batch();
+    batch_n_ = 0;
     if (error_) std::rethrow_exception(error_);
+    if (has_score_ && scores_.size() < out.size()) scores_.resize(out.size());
     std::size_t n = 0;
     try {
         while (n < out.size() && skips_.batch().size() < out.size()) {
@@ -420,6 +446,7 @@ std::size_t Hdf5Reader::read(std::span<Event> out) {
             if (t_[k] < last_t_) [[unlikely]]
                 fail_at(chunk_start_ + k, 2, backwards_message(last_t_, t_[k]));
             last_t_ = t_[k];
+            if (has_score_) scores_[n] = s_[k];
             out[n++] = Event{t_[k], static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y),
                              static_cast<std::uint8_t>(p_[k] > 0)};
         }
@@ -427,6 +454,7 @@ std::size_t Hdf5Reader::read(std::span<Event> out) {
         error_ = std::current_exception();
         if (n == 0 && skips_.batch().empty()) throw;
     }
+    batch_n_ = n;
     return n;
 }
 
@@ -437,7 +465,7 @@ struct Hdf5Writer::Impl {
     // temporary file is removed.
     std::optional<PendingFile> pending;
     Hid file, group;
-    Hid dset[4];  // x, y, t, p
+    Hid dset[5];  // x, y, t, p, score (with_score)
 
     // Gives up the file (a failed write, or no close()): its content no longer matters.
     // libhdf5 1.10 cannot close a file whose writes fail: H5Fclose fails, the file stays
@@ -503,9 +531,9 @@ Hdf5Writer::Hdf5Writer(std::string path, Options options)
                                               options_.filter == 32001 ? 7 : 0, cd); }) < 0)
             throw OutputError(name_, fmt::format("HDF5 cannot set filter {}: {}", options_.filter, hdf5_reason()));
     }
-    const char* names[4] = {"x", "y", "t", "p"};
-    const hid_t types[4] = {H5T_STD_U16LE, H5T_STD_U16LE, H5T_STD_I64LE, H5T_STD_U8LE};
-    for (int i = 0; i < 4; ++i) {
+    const char* names[5] = {"x", "y", "t", "p", "score"};
+    const hid_t types[5] = {H5T_STD_U16LE, H5T_STD_U16LE, H5T_STD_I64LE, H5T_STD_U8LE, H5T_IEEE_F64LE};
+    for (int i = 0; i < (options_.with_score ? 5 : 4); ++i) {
         impl_->dset[i] = Hid(quiet([&] { return H5Dcreate2(impl_->group.get(), names[i], types[i], space.get(), H5P_DEFAULT,
                                                            dcpl.get(), H5P_DEFAULT); }),
                              H5Dclose);
@@ -516,6 +544,7 @@ Hdf5Writer::Hdf5Writer(std::string path, Options options)
     y_.reserve(options_.chunk_events);
     p_.reserve(options_.chunk_events);
     t_.reserve(options_.chunk_events);
+    if (options_.with_score) s_.reserve(options_.chunk_events);
 }
 
 // Without close(): the HDF5 objects close (Impl::abandon), then the temporary file is removed.
@@ -527,13 +556,26 @@ void Hdf5Writer::set_sensor(SensorSize size) {
 }
 
 void Hdf5Writer::write(std::span<const Event> events) {
+    if (options_.with_score) throw std::logic_error("Hdf5Writer: opened with scores, written without");
+    write_events(events, {});
+}
+
+void Hdf5Writer::write(std::span<const Event> events, std::span<const double> scores) {
+    if (!options_.with_score || scores.size() != events.size())
+        throw std::logic_error("Hdf5Writer: scores on a writer opened without, or not one per event");
+    write_events(events, scores);
+}
+
+void Hdf5Writer::write_events(std::span<const Event> events, std::span<const double> scores) {
     if (closed_) throw OutputError(name_, "write after close");
-    for (const Event& e : events) {
+    for (std::size_t i = 0; i < events.size(); ++i) {
+        const Event& e = events[i];
         if (!t_offset_) t_offset_ = e.t;
         x_.push_back(e.x);
         y_.push_back(e.y);
         p_.push_back(e.p != 0);
         t_.push_back(e.t - *t_offset_);
+        if (!scores.empty()) s_.push_back(scores[i]);
         if (x_.size() == options_.chunk_events) flush();
     }
 }
@@ -542,9 +584,9 @@ void Hdf5Writer::flush() {
     if (x_.empty()) return;
     const hsize_t start = written_, count = x_.size(), size = written_ + x_.size();
     Hid mem(H5Screate_simple(1, &count, nullptr), H5Sclose);
-    const void* bufs[4] = {x_.data(), y_.data(), t_.data(), p_.data()};
-    const hid_t mtypes[4] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64, H5T_NATIVE_UINT8};
-    for (int i = 0; i < 4; ++i) {
+    const void* bufs[5] = {x_.data(), y_.data(), t_.data(), p_.data(), s_.data()};
+    const hid_t mtypes[5] = {H5T_NATIVE_UINT16, H5T_NATIVE_UINT16, H5T_NATIVE_INT64, H5T_NATIVE_UINT8, H5T_NATIVE_DOUBLE};
+    for (int i = 0; i < (options_.with_score ? 5 : 4); ++i) {
         const hid_t d = impl_->dset[i].get();
         if (quiet([&] { return H5Dset_extent(d, &size); }) < 0)
             throw OutputError(name_, "HDF5 cannot extend a dataset: " + hdf5_reason(errno));
@@ -558,6 +600,7 @@ void Hdf5Writer::flush() {
     y_.clear();
     p_.clear();
     t_.clear();
+    s_.clear();
 }
 
 void Hdf5Writer::close() {

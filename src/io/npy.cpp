@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "evcorner/error.hpp"
@@ -20,11 +21,11 @@ constexpr char kMagic[] = "\x93NUMPY";
 constexpr std::size_t kHeaderTotal = 192;  // fixed, a multiple of 64, room for any count
 constexpr std::size_t kMaxHeaderLen = 1 << 16;
 
-std::string make_header(std::uint64_t count) {
+std::string make_header(std::uint64_t count, bool with_score) {
     std::string dict = fmt::format(
-        "{{'descr': [('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|u1'), ('_', '|V3')], "
+        "{{'descr': [('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|u1'), ('_', '|V3'){}], "
         "'fortran_order': False, 'shape': ({},), }}",
-        count);
+        with_score ? ", ('score', '<f8')" : "", count);
     const std::size_t len = kHeaderTotal - 10;
     dict.resize(len - 1, ' ');
     dict += '\n';
@@ -46,13 +47,38 @@ std::string regular_file(std::string path) {
 }
 }  // namespace
 
-NpyWriter::NpyWriter(std::string path) : out_(regular_file(std::move(path))) {
-    out_.write(make_header(0));
+NpyWriter::NpyWriter(std::string path, bool with_score)
+    : out_(regular_file(std::move(path))), with_score_(with_score) {
+    out_.write(make_header(0, with_score_));
 }
 
 NpyWriter::~NpyWriter() = default;  // without close(), out_ removes the unfinished file
 
+void NpyWriter::write(std::span<const Event> events, std::span<const double> scores) {
+    if (!with_score_ || scores.size() != events.size())
+        throw std::logic_error("NpyWriter: scores on a writer opened without, or not one per event");
+    constexpr std::size_t kRecord = sizeof(Event) + 8;
+    constexpr std::size_t kBlock = 4096;
+    for (std::size_t i = 0; i < events.size(); i += kBlock) {
+        const std::size_t n = std::min(kBlock, events.size() - i);
+        char* dst = out_.reserve(n * kRecord);
+        std::memset(dst, 0, n * kRecord);
+        for (std::size_t k = i; k < i + n; ++k) {
+            const Event& e = events[k];
+            std::memcpy(dst, &e.t, 8);
+            std::memcpy(dst + 8, &e.x, 2);
+            std::memcpy(dst + 10, &e.y, 2);
+            dst[12] = static_cast<char>(e.p != 0);
+            std::memcpy(dst + 16, &scores[k], 8);
+            dst += kRecord;
+        }
+        out_.commit(n * kRecord);
+    }
+    count_ += events.size();
+}
+
 void NpyWriter::write(std::span<const Event> events) {
+    if (with_score_) throw std::logic_error("NpyWriter: opened with scores, written without");
     // Records are reserved a block at a time (a call per event cost more than the copying).
     constexpr std::size_t kBlock = 4096;
     for (std::size_t i = 0; i < events.size(); i += kBlock) {
@@ -75,7 +101,7 @@ void NpyWriter::close() {
     if (closed_) return;
     // The count goes into the header once every event is written (a temporary file until
     // out_.close() puts it under its name).
-    out_.write_at(0, make_header(count_));
+    out_.write_at(0, make_header(count_, with_score_));
     out_.close();
     closed_ = true;
 }
@@ -377,6 +403,10 @@ NpyReader::NpyReader(InputFile file, ReaderOptions options)
                 found[static_cast<std::size_t>(role)] = 1;
                 fields_[role] = *type;
                 fields_[role].offset = offset;
+            } else if (lower(name) == "score" && type && f.items.size() == 2) {
+                score_field_ = *type;
+                score_field_.offset = offset;
+                has_score_ = true;
             } else if (f.items.size() > 2) {
                 fail(pre, "unsupported dtype: field '" + printable(name) + "' is a sub-array");
             }
@@ -477,6 +507,16 @@ bool NpyReader::decode_general() {
     const std::uint64_t base = offset();
     const std::size_t stride = itemsize_;
     ct_.resize(records);
+    if (has_score_) {
+        cs_.resize(records);
+        if (scores_.size() < batch_count() + batch_room()) scores_.resize(batch_count() + batch_room());
+        with_type(score_field_, [&](auto tag) {
+            using T = decltype(tag);
+            const unsigned char* q = p + score_field_.offset;
+            for (std::size_t i = 0; i < records; ++i)
+                cs_[i] = static_cast<double>(load<T>(q + i * stride, score_field_.swap));
+        });
+    }
     cx_.resize(records);
     cy_.resize(records);
     cp_.resize(records);
@@ -585,15 +625,20 @@ bool NpyReader::decode_general() {
 
     std::size_t i = 0;
     while (i < bad) {
-        i += push_run(bad - i, [&](std::size_t k, Event& e) {
+        const std::size_t at = batch_count();
+        const std::size_t run = push_run(bad - i, [&](std::size_t k, Event& e) {
             const std::size_t j = i + k;
             e.t = ct_[j];
             e.x = static_cast<std::uint16_t>(cx_[j]);
             e.y = static_cast<std::uint16_t>(cy_[j]);
             e.p = static_cast<std::uint8_t>(cp_[j]);
         });
+        if (has_score_) std::copy_n(cs_.begin() + static_cast<std::ptrdiff_t>(i), run, scores_.begin() + static_cast<std::ptrdiff_t>(at));
+        i += run;
         if (i == bad) break;
+        const std::size_t before = batch_count();
         push(ct_[i], cx_[i], cy_[i], cp_[i] != 0, base + i * stride);
+        if (has_score_ && batch_count() > before) scores_[before] = cs_[i];  // not skipped
         ++i;
     }
     if (bad < records) {

@@ -1,5 +1,6 @@
 #include "evcorner/io/text_reader.hpp"
 
+#include <charconv>
 #include <cstring>
 #include <utility>
 
@@ -16,6 +17,8 @@ inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; 
 struct Parsed {
     Event e{};
     const char* error = nullptr;  // reason, or nullptr when the line parsed
+    bool has_score = false;       // a fifth column: "t x y p score"
+    double score = 0;
 };
 
 // Parses "t x y p" from [p, end). `end` excludes the line break.
@@ -59,7 +62,16 @@ Parsed parse_line(const char* p, const char* end) {
         return {r.e, "polarity must be 0 or 1"};
     r.e.p = static_cast<std::uint8_t>(*p++ - '0');
     while (p < end && is_space(*p)) ++p;
-    if (p != end) return {r.e, "unexpected text after the polarity"};
+    if (p != end) {
+        // A score, as evcorner writes corners with their scores.
+        const auto res = std::from_chars(p, end, r.score);
+        if (res.ec != std::errc() || (res.ptr != end && !is_space(*res.ptr)))
+            return {r.e, "unexpected text after the polarity (only a score may follow it)"};
+        p = res.ptr;
+        while (p < end && is_space(*p)) ++p;
+        if (p != end) return {r.e, "unexpected text after the score"};
+        r.has_score = true;
+    }
     return r;
 }
 
@@ -73,6 +85,7 @@ TextReader::TextReader(InputFile file, ReaderOptions options)
 
 std::size_t TextReader::read(std::span<Event> out) {
     skips_.new_batch();
+    batch_n_ = 0;
     if (pending_) std::rethrow_exception(std::exchange(pending_, nullptr));
     std::size_t n = 0;
     try {
@@ -84,6 +97,13 @@ std::size_t TextReader::read(std::span<Event> out) {
             if (q == e || *q == '#') continue;
             const Parsed r = parse_line(b, e);
             if (r.error != nullptr) lines_.fail(b, e, r.error);
+            if (scored_ == Scored::unknown) {
+                scored_ = r.has_score ? Scored::yes : Scored::no;
+                if (r.has_score) scores_.resize(out.size());
+            }
+            if (r.has_score != (scored_ == Scored::yes))
+                lines_.fail(b, e, r.has_score ? "a fifth column (a score), but the first event line had four"
+                                              : "no score, but the first event line had one (t x y p score)");
             if (r.e.t < last_t_) lines_.fail(b, e, backwards_message(last_t_, r.e.t));
             if (options_.sensor && !options_.sensor->contains(r.e)) {
                 if (!options_.skip_invalid) lines_.fail(b, e, outside_sensor_message(r.e.x, r.e.y, options_.sensor));
@@ -91,12 +111,17 @@ std::size_t TextReader::read(std::span<Event> out) {
                 continue;
             }
             last_t_ = r.e.t;
+            if (scored_ == Scored::yes) {
+                if (scores_.size() < out.size()) scores_.resize(out.size());
+                scores_[n] = r.score;
+            }
             out[n++] = r.e;
         }
     } catch (const InputError&) {
         if (n == 0) throw;
         pending_ = std::current_exception();
     }
+    batch_n_ = n;
     events_ += n;
     return n;
 }

@@ -52,8 +52,9 @@ std::size_t format_text_line(const Event& e, char* dst) noexcept {
 std::size_t format_text_line(const Event& e, double score, char* dst) noexcept {
     std::size_t n = format_text_line(e, dst) - 1;  // without its '\n'
     dst[n++] = ' ';
-    // 10 significant digits fit in 32 bytes ("-1.234567891e-308").
-    const auto res = std::to_chars(dst + n, dst + kMaxScoredTextLine - 1, score, std::chars_format::general, 10);
+    // The shortest form that reads back to the same double fits in 32 bytes
+    // ("-2.2250738585072014e-308").
+    const auto res = std::to_chars(dst + n, dst + kMaxScoredTextLine - 1, score);
     n = static_cast<std::size_t>(res.ptr - dst);
     dst[n++] = '\n';
     return n;

@@ -25,26 +25,34 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 
 // ------------------------------------------------------------------ sinks
 
-CornerEventSink::CornerEventSink(std::unique_ptr<io::EventWriter> out) : out_(std::move(out)) {
+CornerEventSink::CornerEventSink(std::unique_ptr<io::EventWriter> out, bool with_score)
+    : out_(std::move(out)), with_score_(with_score) {
     if (!out_) throw std::invalid_argument("CornerEventSink: no writer");
 }
 
 void CornerEventSink::write(const DetectedBatch& b) {
     const std::size_t n = b.events.size();
     if (corners_.size() < n) corners_.resize(n);
+    if (with_score_) {
+        if (b.scores.size() < n) throw std::logic_error("CornerEventSink: the run has no scores (with_score)");
+        if (scores_.size() < n) scores_.resize(n);
+    }
     // Branch-free: corners are a few percent of the events, at data-dependent places.
     std::size_t k = 0;
+    if (with_score_) {
+        for (std::size_t i = 0; i < n; ++i) {
+            corners_[k] = b.events[i];
+            scores_[k] = b.scores[i];
+            k += b.is_corner[i] != 0;
+        }
+        out_->write(std::span<const Event>(corners_.data(), k), std::span<const double>(scores_.data(), k));
+        return;
+    }
     for (std::size_t i = 0; i < n; ++i) {
         corners_[k] = b.events[i];
         k += b.is_corner[i] != 0;
     }
     out_->write(std::span<const Event>(corners_.data(), k));
-}
-
-void ScoredTextSink::write(const DetectedBatch& b) {
-    if (b.scores.size() < b.events.size()) throw std::logic_error("ScoredTextSink: the run has no scores (with_score)");
-    for (std::size_t i = 0; i < b.events.size(); ++i)
-        if (b.is_corner[i]) out_.write(b.events[i], b.scores[i]);
 }
 
 void MaskSink::write(const DetectedBatch& b) {
@@ -301,19 +309,16 @@ DetectSummary detect_file(const DetectFiles& f, const DetectOptions& o, const Pr
     io::check_output_paths({{"input", f.input}}, {{"output", f.output}, {"mask", f.mask}});
     check_detect_options(o);
     const std::string to = f.output.empty() ? std::string() : io::resolve_output_format(f.output, f.to);
-    if (o.with_score && !f.output.empty() && to != "ecd-text")
-        throw std::invalid_argument("--with-score writes 't x y p score' text lines; it cannot write " + to);
+    if (o.with_score && to == "aedat4")
+        throw std::invalid_argument("--with-score: AEDAT 4.0 event packets have no field for a score (formats "
+                                    "that carry scores: " + std::string(io::kScoredOutputFormats) + ")");
     const std::unique_ptr<io::EventReader> reader = io::open_event_reader(f.input, f.reader, f.format);
     const SensorSize size = reader->sensor().value_or(kDavis240);
-    // Scores only fit the text lines ("t x y p score"); every other format takes events,
-    // and records the sensor size the detector ran on where it has a field for it.
+    // The output records the sensor size the detector ran on where it has a field for it.
     std::vector<std::unique_ptr<DetectSink>> owned;
-    if (!f.output.empty()) {
-        if (o.with_score)
-            owned.push_back(std::make_unique<ScoredTextSink>(f.output));
-        else
-            owned.push_back(std::make_unique<CornerEventSink>(io::open_event_writer(f.output, to, size)));
-    }
+    if (!f.output.empty())
+        owned.push_back(
+            std::make_unique<CornerEventSink>(io::open_event_writer(f.output, to, size, o.with_score), o.with_score));
     if (!f.mask.empty()) owned.push_back(std::make_unique<MaskSink>(f.mask));
     std::vector<DetectSink*> sinks;
     for (const auto& p : owned) sinks.push_back(p.get());

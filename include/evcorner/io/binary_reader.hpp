@@ -97,6 +97,8 @@ protected:
     // -- the events
     [[nodiscard]] bool batch_full() const noexcept { return n_ == out_.size(); }
     [[nodiscard]] std::size_t batch_room() const noexcept { return out_.size() - n_; }
+    /// Events in the batch so far (after read(): the count it returned).
+    [[nodiscard]] std::size_t batch_count() const noexcept { return n_; }
     /// Validates and appends one event; `at` is the file offset of its record.
     void push(std::int64_t t, std::uint32_t x, std::uint32_t y, bool on, std::uint64_t at) {
         if (x >= limit_w_ || y >= limit_h_) [[unlikely]] {

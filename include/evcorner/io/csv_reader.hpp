@@ -6,7 +6,8 @@
 // seconds when the first time has a decimal point, else microseconds (docs/formats.md,
 // "Times": rounding to the nearest microsecond, and the times refused);
 // p is 1 or 0 (-1 also means OFF). Spaces around fields, '#' comment lines, blank lines
-// and CRLF are accepted. Errors name the file and the 1-based line.
+// and CRLF are accepted. A column named `score` holds a number per event (corners written
+// with their scores), given by scores_in_batch(). Errors name the file and the 1-based line.
 
 #include <array>
 #include <exception>
@@ -29,6 +30,10 @@ public:
 
     std::size_t read(std::span<Event> out) override;
     [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
+    /// A `score` column's values (named in the header row or ReaderOptions::csv_columns).
+    [[nodiscard]] std::span<const double> scores_in_batch() const noexcept override {
+        return has_score_ ? std::span<const double>(scores_.data(), batch_n_) : std::span<const double>();
+    }
     [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
     /// "csv", or "csv+gzip" (zstd, bzip2, xz) for a compressed file.
@@ -38,7 +43,7 @@ public:
     [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override { return lines_.file().size(); }
 
 private:
-    enum Field : std::uint8_t { kT, kX, kY, kP, kIgnore };
+    enum Field : std::uint8_t { kT, kX, kY, kP, kIgnore, kScore };
     void set_columns(const std::string& spec, bool from_header);
     bool parse(const char* b, const char* e, Event& ev, const char*& why);
     enum class Tri : std::uint8_t { unknown, no, yes };
@@ -52,6 +57,10 @@ private:
     bool unit_given_ = false;
     Tri float_time_ = Tri::unknown;  // without a unit given: whether the first time had a decimal point
     bool columns_known_ = false;
+    bool has_score_ = false;
+    double score_ = 0;            // the line being parsed
+    std::vector<double> scores_;  // the last batch's
+    std::size_t batch_n_ = 0;
     bool seen_row_ = false;  // a header row may only come first
     std::int64_t last_t_ = INT64_MIN;
     SkipLog skips_;

@@ -68,6 +68,10 @@ public:
 
     virtual std::size_t read(std::span<Event> out) = 0;
     [[nodiscard]] virtual std::span<const SkipRun> skipped_in_batch() const noexcept = 0;
+    /// The scores of the events the last read() returned, one each, for a file that holds
+    /// them (corner files written with scores: text's fifth column, CSV's and .npy's
+    /// `score`, HDF5's events/score); empty when it holds none.
+    [[nodiscard]] virtual std::span<const double> scores_in_batch() const noexcept { return {}; }
     /// Events skipped so far.
     [[nodiscard]] virtual std::uint64_t skipped() const noexcept = 0;
     /// The sensor events are validated against (options, else file metadata), if known.

@@ -20,6 +20,10 @@ public:
     /// as it was); standard output keeps what was written.
     virtual ~EventWriter() = default;
     virtual void write(std::span<const Event> events) = 0;
+    /// Writes events with one score each (scores.size() == events.size()), on a writer
+    /// opened with scores (open_event_writer(..., with_score)); its readers give them back
+    /// (EventReader::scores_in_batch()). Throws std::logic_error on one opened without.
+    virtual void write(std::span<const Event> events, std::span<const double> scores);
     /// The sensor size to record, for formats that have a field for it (AEDAT 4.0, HDF5;
     /// the others ignore it); replaces the one given when opening. Call before close().
     /// Throws OutputError when it cannot hold the events written.
@@ -52,7 +56,15 @@ std::string resolve_output_format(const std::string& path, std::string_view form
 /// (AEDAT 4.0, HDF5; nullopt: set_sensor() before close(), else AEDAT 4.0 records the
 /// smallest size holding every event and HDF5 none). Throws OutputError, or
 /// std::invalid_argument for the format.
+///
+/// `with_score`: each event carries a score (EventWriter::write(events, scores)): text
+/// "t x y p score" lines, a CSV `score` column, a .npy `score` field ('<f8'), HDF5
+/// events/score (float64). AEDAT 4.0's event packets have no field for one: with_score
+/// there is std::invalid_argument.
 std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format = "auto",
-                                               std::optional<SensorSize> sensor = std::nullopt);
+                                               std::optional<SensorSize> sensor = std::nullopt,
+                                               bool with_score = false);
+/// The formats whose writer carries scores (with_score), as names of kOutputFormats.
+inline constexpr std::string_view kScoredOutputFormats = "ecd-text, csv, npy, hdf5";
 
 }  // namespace evcorner::io

@@ -17,7 +17,8 @@
 // The writer writes the DSEC layout: events/{x,y} uint16, events/p uint8, events/t
 // int64 (microseconds after t_offset), t_offset int64 (the first event's time),
 // extendible chunked datasets, optionally compressed; root attributes width / height
-// when the sensor size is known.
+// when the sensor size is known; with scores, events/score float64 (read back by the
+// reader, from any numeric events/score dataset of a DSEC-layout file).
 //
 // Errors name the file and the event index; where HDF5 tells the file address of the
 // data (contiguous storage, or the chunk holding the event), also that byte offset.
@@ -55,6 +56,10 @@ public:
 
     std::size_t read(std::span<Event> out) override;
     [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
+    /// events/score (DSEC layout), when the file has it.
+    [[nodiscard]] std::span<const double> scores_in_batch() const noexcept override {
+        return has_score_ ? std::span<const double>(scores_.data(), batch_n_) : std::span<const double>();
+    }
     [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
     [[nodiscard]] std::string_view format() const noexcept override { return "hdf5"; }
@@ -85,7 +90,10 @@ private:
     // The current chunk: events [chunk_start_, chunk_start_ + chunk_n_).
     std::vector<std::int32_t> x_, y_, p_;
     std::vector<std::int64_t> t_;
-    std::vector<double> ts_;
+    std::vector<double> ts_, s_;
+    bool has_score_ = false;
+    std::vector<double> scores_;  // the last batch's
+    std::size_t batch_n_ = 0;
     std::uint64_t chunk_start_ = 0;
     std::size_t chunk_n_ = 0, next_ = 0;
 
@@ -101,6 +109,8 @@ public:
         /// 0: none; 1: deflate (built into HDF5); 32001: Blosc with ZSTD (needs the plugin).
         int filter = 0;
         std::size_t chunk_events = std::size_t{1} << 14;
+        /// events/score (float64), one per event: write(events, scores).
+        bool with_score = false;
     };
     /// Whether HDF5 can use filter `id` (built in, or a plugin it finds).
     static bool filter_available(int id);
@@ -111,6 +121,7 @@ public:
     explicit Hdf5Writer(std::string path) : Hdf5Writer(std::move(path), Options{}) {}
     ~Hdf5Writer() override;  ///< without close(): no file under the name
     void write(std::span<const Event> events) override;
+    void write(std::span<const Event> events, std::span<const double> scores) override;
     /// The size written as the root attributes width / height at close().
     void set_sensor(SensorSize size) override;
     void close() override;
@@ -119,6 +130,7 @@ public:
 private:
     struct Impl;
     void flush();
+    void write_events(std::span<const Event> events, std::span<const double> scores);
 
     std::unique_ptr<Impl> impl_;
     std::string name_;
@@ -126,6 +138,7 @@ private:
     std::vector<std::uint16_t> x_, y_;
     std::vector<std::uint8_t> p_;
     std::vector<std::int64_t> t_;
+    std::vector<double> s_;
     std::uint64_t written_ = 0;
     std::optional<std::int64_t> t_offset_;
     bool closed_ = false;

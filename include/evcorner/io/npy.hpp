@@ -36,9 +36,11 @@ class NpyWriter final : public EventWriter {
 public:
     /// Creates `path` (a seekable file: the count goes in the header at close; not standard
     /// output). Throws OutputError.
-    explicit NpyWriter(std::string path);
+    /// with_score: records carry a score, the field ('score', '<f8') after the padding.
+    explicit NpyWriter(std::string path, bool with_score = false);
     ~NpyWriter() override;  ///< without close(): no file under the name
     void write(std::span<const Event> events) override;
+    void write(std::span<const Event> events, std::span<const double> scores) override;
     /// Writes the final event count into the header; throws OutputError.
     void close() override;
     [[nodiscard]] const std::string& name() const noexcept override { return out_.name(); }
@@ -46,6 +48,7 @@ public:
 private:
     OutputFile out_;
     std::uint64_t count_ = 0;
+    bool with_score_;
     bool closed_ = false;
 };
 
@@ -60,6 +63,10 @@ public:
     [[nodiscard]] std::string_view format() const noexcept override { return "npy"; }
     /// The array length the header declares.
     [[nodiscard]] std::uint64_t declared_events() const noexcept { return declared_; }
+    /// A structured array's field named 'score' (any numeric type), as doubles.
+    [[nodiscard]] std::span<const double> scores_in_batch() const noexcept override {
+        return has_score_ ? std::span<const double>(scores_.data(), batch_count()) : std::span<const double>();
+    }
 
     /// One field of a record: where it is and its numpy type.
     struct Field {
@@ -84,6 +91,9 @@ private:
     // Column-wise conversion buffers of decode_general().
     std::vector<std::int64_t> ct_;
     std::vector<std::uint32_t> cx_, cy_, cp_;
+    bool has_score_ = false;
+    Field score_field_;
+    std::vector<double> cs_, scores_;  // the score column; the batch's scores
 };
 
 }  // namespace evcorner::io

@@ -2,7 +2,9 @@
 // Streaming reader for the Event-Camera-Dataset text format (Mueggler et al., IJRR 2017):
 // one event per line, "t x y p", t in seconds (up to 9 decimals read exactly; a nonzero
 // digit past the 9th is an error: docs/formats.md, "Times"), x and y pixel coordinates,
-// p = 1 (ON) or 0 (OFF), separated by spaces or tabs.
+// p = 1 (ON) or 0 (OFF), separated by spaces or tabs. A fifth column is a score ("t x y p
+// score", as evcorner writes corners with their scores): the first event line says
+// whether every line has one, and scores_in_batch() gives them.
 // Blank lines and lines starting with '#' are skipped; CRLF line ends are accepted.
 //
 // Time is rounded to the nearest microsecond (halves away from zero) with integer
@@ -39,6 +41,9 @@ public:
     std::size_t read(std::span<Event> out) override;
 
     [[nodiscard]] std::span<const SkipRun> skipped_in_batch() const noexcept override { return skips_.batch(); }
+    [[nodiscard]] std::span<const double> scores_in_batch() const noexcept override {
+        return scored_ == Scored::yes ? std::span<const double>(scores_.data(), batch_n_) : std::span<const double>();
+    }
     [[nodiscard]] std::uint64_t skipped() const noexcept override { return skips_.total(); }
     [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return options_.sensor; }
     /// "ecd-text", or "ecd-text+gzip" (zstd, bzip2, xz) for a compressed file.
@@ -55,6 +60,9 @@ private:
     std::string format_;
     ReaderOptions options_;
     std::uint64_t events_ = 0;
+    enum class Scored : std::uint8_t { unknown, no, yes } scored_ = Scored::unknown;
+    std::vector<double> scores_;  // the last batch's, with a score column
+    std::size_t batch_n_ = 0;
     std::int64_t last_t_ = INT64_MIN;
     SkipLog skips_;
     std::exception_ptr pending_;

@@ -17,8 +17,8 @@ public:
     explicit TextWriter(std::string path) : out_(std::move(path)) {}
 
     void write(const Event& e);
-    /// Writes "t x y p score": the event's line with a score appended (10 significant
-    /// digits, shortest form; "nan" when there is none).
+    /// Writes "t x y p score": the event's line with a score appended (the shortest form
+    /// that reads back to the same double; "nan" when there is none).
     void write(const Event& e, double score);
     void write(std::span<const Event> events) {
         for (const Event& e : events) write(e);

@@ -52,27 +52,19 @@ public:
     virtual void close() {}
 };
 
-/// The corner events, to any event writer (io/event_writer.hpp).
+/// The corner events, to any event writer (io/event_writer.hpp); with `with_score`, with
+/// their scores (a writer opened with scores, and a run with DetectOptions::with_score).
 class CornerEventSink final : public DetectSink {
 public:
-    explicit CornerEventSink(std::unique_ptr<io::EventWriter> out);
+    explicit CornerEventSink(std::unique_ptr<io::EventWriter> out, bool with_score = false);
     void write(const DetectedBatch& batch) override;
     void close() override { out_->close(); }
 
 private:
     std::unique_ptr<io::EventWriter> out_;
+    bool with_score_;
     std::vector<Event> corners_;
-};
-
-/// The corner events with their scores, as "t x y p score" text lines (needs with_score).
-class ScoredTextSink final : public DetectSink {
-public:
-    explicit ScoredTextSink(const std::string& path) : out_(path) {}
-    void write(const DetectedBatch& batch) override;
-    void close() override { out_.close(); }
-
-private:
-    io::TextWriter out_;
+    std::vector<double> scores_;
 };
 
 /// One line per input event: "1" a corner, "0" not (events the reader skipped: "0").
@@ -158,9 +150,9 @@ struct DetectFiles {
 };
 
 /// Opens the input and the outputs (after checking that no output is the input or
-/// another output), runs run_detect() and returns its summary. Outputs are text lines
-/// "t x y p score" with with_score, else events in the format `to` names, recording the
-/// sensor size where the format has a field for it.
+/// another output), runs run_detect() and returns its summary. Outputs are events in the
+/// format `to` names (with_score: with their scores, io::kScoredOutputFormats), recording
+/// the sensor size where the format has a field for it.
 DetectSummary detect_file(const DetectFiles& files, const DetectOptions& options, const ProgressFn& progress = {});
 
 }  // namespace evcorner::pipeline
