@@ -87,6 +87,12 @@ TEST(RosBagReal, FolderReadsLikeItsFile) {
         const ReadResult b = read_all(*single);
         EXPECT_EQ(a.events, b.events);
         EXPECT_FALSE(a.events.empty());
+        // The folder's metadata.yaml given as the input opens the folder's bag.
+        auto yaml = io::open_event_reader(real(dir) + "/metadata.yaml");
+        EXPECT_EQ(yaml->format(), folder->format());
+        const ReadResult c = read_all(*yaml);
+        ASSERT_FALSE(c.failed) << c.error;
+        EXPECT_EQ(c.events, a.events);
     }
 }
 

@@ -251,8 +251,15 @@ std::string detect_format(const std::string& path) {
 
 std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOptions options,
                                                std::string_view format) {
-    // A folder is a rosbag2 bag (metadata.yaml and its .db3 / .mcap files).
+    // A folder is a rosbag2 bag (metadata.yaml and its .db3 / .mcap files), and so is the
+    // folder of a rosbag2 metadata.yaml given itself.
     if (std::error_code ec; std::filesystem::is_directory(path, ec)) return open_bag_reader(path, std::move(options), format);
+    if (const std::filesystem::path p(path); p.filename() == "metadata.yaml" && (format == "auto" || format == "rosbag2")) {
+        std::error_code ec;
+        if (std::filesystem::is_regular_file(p, ec))
+            return open_bag_reader(p.has_parent_path() ? p.parent_path().string() : std::string("."), std::move(options),
+                                   format);
+    }
     InputFile file(path);
     std::string fmt_name(format);
     if (fmt_name == "auto") fmt_name = detect_format(file);
