@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -12,6 +14,7 @@
 
 #include "cli_test_util.hpp"
 #include "evcorner/registry.hpp"
+#include "evcorner/event.hpp"
 #include "evcorner/io/text_reader.hpp"
 
 namespace evcorner {
@@ -214,7 +217,142 @@ TEST_F(CliEval, FolderOfEventFilesAndNoPaperRows) {
     fs::create_directories(dir_ / "empty");
     write("empty/notes.md", "x\n");
     EXPECT_EQ(run_status("eval empty -q", &err), 2);
-    EXPECT_NE(err.find("empty: no <sequence>/events.txt folder and no event file"), std::string::npos) << err;
+    EXPECT_NE(err.find("empty: no <sequence>/events.txt folder, no rosbag2 folder (metadata.yaml) and no event file"),
+              std::string::npos)
+        << err;
+}
+
+std::string le32(std::uint32_t v) {
+    std::string b(4, '\0');
+    for (int i = 0; i < 4; ++i) b[i] = static_cast<char>(v >> (8 * i));
+    return b;
+}
+
+// A MAT 5 file (little-endian, uncompressed) with one N x 4 double matrix "events" of
+// columns x, y, p, t (microseconds).
+std::string mat5_events(const std::vector<Event>& ev) {
+    std::string head(128, ' ');
+    const std::string text = "MATLAB 5.0 MAT-file, written by test_cli_eval";
+    head.replace(0, text.size(), text);
+    std::fill(head.begin() + 116, head.end(), '\0');
+    head[125] = '\1';
+    head[126] = 'I';
+    head[127] = 'M';
+    const auto n = static_cast<std::uint32_t>(ev.size());
+    std::string body = le32(6) + le32(8) + le32(6) + le32(0);  // array flags: double
+    body += le32(5) + le32(8) + le32(n) + le32(4);             // dimensions N x 4
+    body += le32(1) + le32(6) + std::string("events\0\0", 8);  // name
+    body += le32(9) + le32(n * 32);                            // real part, column by column
+    for (int col = 0; col < 4; ++col)
+        for (const Event& e : ev) {
+            const double v = col == 0 ? e.x : col == 1 ? e.y : col == 2 ? e.p : static_cast<double>(e.t);
+            body += std::string(reinterpret_cast<const char*>(&v), 8);
+        }
+    return head + le32(14) + le32(static_cast<std::uint32_t>(body.size())) + body;
+}
+
+// ATIS .bin records: x, y, then polarity and the 23-bit time (microseconds).
+std::string atis_events(const std::vector<Event>& ev) {
+    std::string out;
+    for (const Event& e : ev) {
+        const auto t = static_cast<std::uint32_t>(e.t);
+        out += {static_cast<char>(e.x), static_cast<char>(e.y), static_cast<char>((e.p ? 0x80 : 0) | ((t >> 16) & 0x7f)),
+                static_cast<char>((t >> 8) & 0xff), static_cast<char>(t & 0xff)};
+    }
+    return out;
+}
+
+// eval FOLDER takes every kind of event file the library reads: the same events as text,
+// gzip-compressed text, CSV, .npy, AEDAT 4, HDF5, MATLAB .mat and ATIS .bin give the same
+// row; a file of another kind is skipped with a note.
+TEST_F(CliEval, FolderTakesEveryFormatTheLibraryReads) {
+    std::vector<Event> events = io::read_text_file(sample_.string());
+    ASSERT_GT(events.size(), 1000u);
+    const std::int64_t t0 = events.front().t;
+    for (Event& e : events) e.t -= t0;  // within the ATIS clock's 23 bits
+    ASSERT_LT(events.back().t, std::int64_t{1} << 23);
+    std::string text;
+    for (const Event& e : events) text += fmt::format("{}.{:06d} {} {} {}\n", e.t / 1'000'000, e.t % 1'000'000, e.x, e.y, int(e.p));
+    fs::create_directories(dir_ / "rec");
+    write("rec/a_text.txt", text);
+    for (const char* f : {"b_csv.csv", "c_npy.npy", "d_aedat4.aedat4", "e_hdf5.h5"})
+        ASSERT_EQ(run_status(std::string("convert rec/a_text.txt rec/") + f), 0) << f;
+    ASSERT_EQ(std::system(("gzip -c '" + (dir_ / "rec/a_text.txt").string() + "' > '" +
+                           (dir_ / "rec/f_gzip.TXT.gz").string() + "'").c_str()),
+              0);
+    write("rec/g_mat.mat", mat5_events(events));
+    write("rec/h_atis.bin", atis_events(events));
+    write("rec/notes.yaml", "not events\n");
+    std::string err;
+    ASSERT_EQ(run_status("eval rec -d efast --repeat 1 --report rep --no-figures", &err), 0) << err;
+    EXPECT_NE(err.find("notes.yaml: skipped"), std::string::npos) << err;
+    const auto rows = csv_rows(slurp(dir_ / "rep/table1.csv"));
+    const char* names[] = {"a_text", "b_csv", "c_npy", "d_aedat4", "e_hdf5", "f_gzip", "g_mat", "h_atis"};
+    ASSERT_EQ(rows.size(), std::size(names)) << slurp(dir_ / "rep/table1.csv");
+    const std::string tail = rows[0].substr(rows[0].find(','));
+    EXPECT_EQ(tail.rfind(",efast," + std::to_string(events.size()) + ",", 0), 0u) << tail;
+    for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(rows[i], names[i] + tail);
+}
+
+// ROS bags in a folder: .bag, .db3 and .mcap files and rosbag2 folders (metadata.yaml) are
+// sequences, read (here: refused, for they are cut short after their magic bytes) and
+// never skipped by their name.
+TEST_F(CliEval, FolderTakesBagFilesAndRosbag2Folders) {
+    const std::string sqlite("SQLite format 3\0", 16);
+    for (const auto& [f, magic] : {std::pair<std::string, std::string>{"x.bag", "#ROSBAG V2.0\n"},
+                                   {"x.db3", sqlite},
+                                   {"x.MCAP", "\x89MCAP0\r\n"}}) {
+        const std::string folder = "in-" + f;
+        fs::create_directories(dir_ / folder);
+        write(folder + "/" + f, magic + "cut");
+        std::string err;
+        EXPECT_EQ(run_status("eval " + folder + " -d efast --repeat 1 -q --no-figures", &err), 1) << f;
+        EXPECT_NE(err.find("evcorner: error: " + folder + "/" + f), std::string::npos) << err;
+        EXPECT_EQ(err.find("skipped"), std::string::npos) << err;
+        EXPECT_EQ(err.find("expected a timestamp"), std::string::npos) << err;  // not read as text
+    }
+    // A rosbag2 folder inside a folder, and given itself: one sequence, the folder.
+    fs::create_directories(dir_ / "top/bag2");
+    write("top/bag2/metadata.yaml", "rosbag2_bagfile_information:\n  relative_file_paths:\n    - part_0.db3\n");
+    write("top/bag2/part_0.db3", sqlite + "cut");
+    for (const char* in : {"top", "top/bag2"}) {
+        std::string err;
+        EXPECT_EQ(run_status(std::string("eval ") + in + " -d efast --repeat 1 -q --no-figures", &err), 1) << in;
+        EXPECT_NE(err.find("top/bag2/part_0.db3"), std::string::npos) << err;
+        EXPECT_EQ(err.find("no <sequence>/events.txt"), std::string::npos) << err;
+    }
+}
+
+// The real recordings of the formats eval's folders took no file of before: the events
+// and corners of each equal detect's on the same input.
+TEST_F(CliEval, FolderOfRealMatAtisAndBagRecordings) {
+    EVCORNER_REQUIRE_SHARED_DATA();
+    const fs::path real = test::shared_data() / "real";
+    const std::vector<std::pair<std::string, fs::path>> inputs = {
+        {"building", real / "rpg-event-lifetime/building.mat"},
+        {"sample_nmnist", real / "tonic-testdata/sample_nmnist.bin"},
+        {"test_events_1.bag", real / "ros2-event-camera-py/ros1/test_events_1.bag"},
+        {"test_events_1", real / "ros2-event-camera-py/test_events_1"},
+        {"test_events_2_0", real / "ros2-event-camera-py/test_events_2/test_events_2_0.mcap"},
+        {"libcaer_rollover_0", real / "ros2-event-camera-codecs/test_data_libcaer_rollover/libcaer_rollover_0.db3"}};
+    fs::create_directories(dir_ / "rec");
+    for (const auto& [name, path] : inputs) {
+        ASSERT_TRUE(fs::exists(path)) << path;
+        fs::create_symlink(path, dir_ / "rec" / path.filename());
+    }
+    std::string err;
+    ASSERT_EQ(run_status("eval rec -d efast --repeat 1 --report rep --no-figures", &err), 0) << err;
+    const auto rows = csv_rows(slurp(dir_ / "rep/table1.csv"));
+    ASSERT_EQ(rows.size(), inputs.size()) << slurp(dir_ / "rep/table1.csv");
+    for (const auto& [name, path] : inputs) {
+        ASSERT_EQ(run_status("detect '" + path.string() + "' -d efast -q -o /dev/null --summary-json s.json", &err), 0)
+            << err;
+        const nlohmann::json s = nlohmann::json::parse(slurp(dir_ / "s.json"));
+        const std::string want = fmt::format("{},efast,{},{},", name, s.at("events").get<std::size_t>(),
+                                             s.at("corners").get<std::size_t>());
+        EXPECT_TRUE(std::any_of(rows.begin(), rows.end(), [&](const std::string& r) { return r.rfind(want, 0) == 0; }))
+            << want << "\n" << slurp(dir_ / "rep/table1.csv");
+    }
 }
 
 // Issue 15 item 9: label --json - mixed the summary into the JSON on standard output.

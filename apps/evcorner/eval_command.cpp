@@ -8,6 +8,7 @@
 // detectors is reported.
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -38,6 +39,7 @@
 #include "evcorner/eval/truth_match.hpp"
 #include "evcorner/render/charts.hpp"
 #include "evcorner/sim/truth.hpp"
+#include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
 #include "evcorner/render/figures.hpp"
@@ -143,18 +145,28 @@ std::string file_stem(std::string name) {
     return name;
 }
 
-// The extensions of the event files evcorner reads (case-insensitive); a folder given as
-// input contributes its files with these extensions, besides <sequence>/events.txt folders.
-const std::vector<std::string>& event_extensions() {
-    static const std::vector<std::string> e{".txt", ".csv", ".npy", ".aedat", ".aedat2", ".aedat4",
-                                            ".raw", ".dat", ".h5", ".hdf5"};
-    return e;
+// The extensions of the event files evcorner reads, as a help text lists them: a folder
+// given as input contributes its files with these (io::is_event_input_path), besides
+// <sequence>/events.txt folders and rosbag2 bag folders.
+std::string event_extensions_text() {
+    std::string text;
+    for (const std::string_view e : io::input_file_extensions()) text += (text.empty() ? "" : " ") + std::string(e);
+    std::string compressed;
+    for (const std::string_view c : io::input_compression_extensions())
+        compressed += (compressed.empty() ? "" : " ") + std::string(c);
+    return text + ", .txt/.csv compressed " + compressed;
 }
 
-bool has_event_extension(const fs::path& p) {
-    std::string ext = p.extension().string();
+// A file's name without its extension, and without a compression's before it ("a" for
+// a.txt.gz).
+std::string file_stem_of(const fs::path& file) {
+    fs::path stem = file.stem();
+    std::string ext = file.extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return std::find(event_extensions().begin(), event_extensions().end(), ext) != event_extensions().end();
+    const auto compressions = io::input_compression_extensions();
+    if (std::find(compressions.begin(), compressions.end(), ext) != compressions.end() && stem.has_extension())
+        stem = stem.stem();
+    return stem.string();
 }
 
 // Makes every name unique. Inputs of one name that are different files take, all alike,
@@ -208,39 +220,40 @@ std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
     for (const auto& in : inputs) {
         const fs::path p(in);
         if (fs::is_directory(p)) {
-            if (fs::is_regular_file(p / "events.txt")) {
+            const bool bag = io::is_event_input_path(p);  // a rosbag2 folder: one sequence
+            if (bag || fs::is_regular_file(p / "events.txt")) {
                 const std::string name = fs::absolute(p).lexically_normal().filename().string();
-                seqs.push_back({name, name, p / "events.txt", {}, {}});
+                seqs.push_back({name, name, bag ? p : p / "events.txt", {}, {}});
                 continue;
             }
-            // <sequence>/events.txt folders (the dataset's layout) and event files.
-            std::vector<fs::path> dirs, files, skipped;
+            // <sequence>/events.txt folders (the dataset's layout), rosbag2 folders and event files.
+            std::vector<fs::path> dirs, bags, files, skipped;
             for (const auto& d : fs::directory_iterator(p)) {
                 if (d.is_directory()) {
                     if (fs::is_regular_file(d.path() / "events.txt")) dirs.push_back(d.path());
+                    else if (io::is_event_input_path(d.path())) bags.push_back(d.path());
                 } else if (d.is_regular_file()) {
                     if (is_suite_companion(d.path())) continue;
-                    (has_event_extension(d.path()) ? files : skipped).push_back(d.path());
+                    (io::is_event_input_path(d.path()) ? files : skipped).push_back(d.path());
                 }
             }
             std::sort(dirs.begin(), dirs.end());
+            std::sort(bags.begin(), bags.end());
             std::sort(files.begin(), files.end());
             std::sort(skipped.begin(), skipped.end());
-            if (dirs.empty() && files.empty()) {
-                std::string exts;
-                for (const auto& e : event_extensions()) exts += (exts.empty() ? "" : " ") + e;
-                throw std::invalid_argument(in + ": no <sequence>/events.txt folder and no event file (" + exts +
-                                            ") inside");
-            }
+            if (dirs.empty() && bags.empty() && files.empty())
+                throw std::invalid_argument(in + ": no <sequence>/events.txt folder, no rosbag2 folder (metadata.yaml) "
+                                                 "and no event file (" + event_extensions_text() + ") inside");
             for (const auto& f : skipped)
                 fmt::print(stderr, "eval: {}: skipped, not an event file by its extension\n", f.string());
             for (const auto& d : dirs) seqs.push_back({d.filename().string(), d.filename().string(), d / "events.txt", {}, {}});
-            for (const auto& f : files) seqs.push_back({f.stem().string(), f.stem().string(), f, {}, {}});
+            for (const auto& d : bags) seqs.push_back({d.filename().string(), d.filename().string(), d, {}, {}});
+            for (const auto& f : files) seqs.push_back({file_stem_of(f), file_stem_of(f), f, {}, {}});
         } else {
             // events.txt in a sequence folder takes the folder's name, other files their stem.
             const std::string name = p.filename() == "events.txt" && p.has_parent_path()
                                          ? fs::absolute(p).parent_path().filename().string()
-                                         : p.stem().string();
+                                         : file_stem_of(p);
             seqs.push_back({name, name, p, {}, {}});
         }
     }
@@ -1008,9 +1021,9 @@ void add_eval_command(CLI::App& app) {
         "corner events on feature tracks (Table 1), per detector the time per event and the\n"
         "largest event rate it sustains (Table 2).");
     cmd->add_option("INPUTS", o->inputs,
-                    "Sequence files, or folders: a folder with events.txt is one sequence; any other gives "
-                    "its <sequence>/events.txt folders and its event files (.txt .csv .npy .aedat .aedat2 "
-                    ".aedat4 .raw .dat .h5 .hdf5), other files skipped with a note")
+                    "Sequence files, or folders: a folder with events.txt, or a rosbag2 folder (metadata.yaml), "
+                    "is one sequence; any other gives its <sequence>/events.txt folders, its rosbag2 folders and "
+                    "its event files (" + event_extensions_text() + "), other files skipped with a note")
         ->required();
     cmd->add_option("-d,--detectors", o->detectors,
                     "Comma-separated detectors, or all [default: all, each with its defaults (the paper's for "

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -247,6 +248,36 @@ std::string detect_format(InputFile& file) {
 std::string detect_format(const std::string& path) {
     InputFile file(path);
     return detect_format(file);
+}
+
+std::span<const std::string_view> input_file_extensions() noexcept {
+    static constexpr std::array<std::string_view, 15> kExtensions = {
+        ".txt", ".csv", ".npy", ".aedat", ".aedat2", ".aedat4", ".raw", ".dat",
+        ".h5",  ".hdf5", ".bin", ".mat", ".bag",    ".db3",    ".mcap"};
+    return kExtensions;
+}
+
+std::span<const std::string_view> input_compression_extensions() noexcept {
+    static constexpr std::array<std::string_view, 4> kExtensions = {".gz", ".zst", ".bz2", ".xz"};
+    return kExtensions;
+}
+
+bool is_event_input_path(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) return std::filesystem::is_regular_file(path / "metadata.yaml", ec);
+    const auto lower_extension = [](const std::filesystem::path& p) {
+        std::string e = p.extension().string();
+        for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        return e;
+    };
+    const auto listed = [](std::span<const std::string_view> list, const std::string& e) {
+        return std::find(list.begin(), list.end(), e) != list.end();
+    };
+    const std::string ext = lower_extension(path);
+    if (listed(input_file_extensions(), ext)) return true;
+    if (!listed(input_compression_extensions(), ext)) return false;
+    const std::string inner = lower_extension(path.stem());
+    return inner == ".txt" || inner == ".csv";
 }
 
 std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOptions options,

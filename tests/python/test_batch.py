@@ -1,5 +1,7 @@
 """Batches on Dask distributed: a LocalCluster of 2 workers, an external scheduler with two
-`dask worker` processes on 127.0.0.1, failures, and resuming an interrupted batch."""
+`dask worker` processes on 127.0.0.1, failures, bad options, a lost scheduler, temporary
+files, and resuming an interrupted batch. Every process a test starts is on 127.0.0.1 and
+stopped at its end (its process group killed), failed or not."""
 
 import json
 import os
@@ -103,6 +105,105 @@ def test_parameter_grid_and_a_failure_do_not_stop_the_others(client, recordings,
     assert "FAILED" in batch.table(records)
 
 
+def outputs(folder):
+    """Every file under `folder` but the batch log, by path relative to it."""
+    return sorted(str(p.relative_to(folder)) for p in Path(folder).rglob("*") if p.is_file()
+                  and p.name != "results.jsonl")
+
+
+@pytest.mark.parametrize("to", ["txt", "npy", "aedat4", "h5"])
+def test_a_failed_task_leaves_no_output(client, recordings, tmp_path, to):
+    """Damage after thousands of good events: the library has written part of the corner
+    file when it fails; the task leaves nothing, neither corners nor JSON nor a temporary."""
+    text = Path(recordings[1]).read_text().splitlines()
+    damaged = tmp_path / "in" / "late.txt"
+    damaged.parent.mkdir()
+    damaged.write_text("\n".join(text[:9000] + ["0.5 1 2 1 extra"] + text[9000:]) + "\n")
+    out = tmp_path / "out"
+    tasks = batch.plan([damaged, recordings[2]], DETECTORS, out, to=to)
+    # A corner file of an earlier failed attempt, without its JSON, goes too.
+    os.makedirs(tasks[0]["dir"])
+    Path(tasks[0]["corners"]).write_text("stale\n")
+    records = batch.gather(tasks, batch.submit(client, tasks), out)
+    assert [r["status"] for r in records] == ["failed", "failed", "ok", "ok"], records
+    assert all("late.txt:9001" in r["error"] for r in records[:2])
+    done = [t for t in tasks[2:]]
+    assert outputs(out) == sorted(str(Path(p).relative_to(out)) for t in done for p in (t["corners"], t["summary"]))
+
+
+def test_failed_rows_tell_files_of_one_name_apart(client, tmp_path):
+    inputs = []
+    for d in ("a/x", "b/x", "c"):
+        f = tmp_path / d / "events.txt"
+        f.parent.mkdir(parents=True)
+        f.write_text("0.000001 1 2 1\nnot an event\n")
+        inputs.append(str(f))
+    records = batch.run(client, inputs, ["efast"], tmp_path / "out")
+    text = batch.table(records).splitlines()
+    assert text[0] == f"inputs in {tmp_path}/"
+    rows = [line.split()[0] for line in text[2:]]
+    assert rows == ["a/x/events.txt", "b/x/events.txt", "c/events.txt"]
+    assert all("FAILED: InputError" in line for line in text[2:])
+    assert len({r["recording"] for r in records}) == 3
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--to", "xyz"], "unknown corner file format 'xyz'"),
+    (["-p", "harris_window=5,4"], "harris harris_window=4: harris_window must be within 5..15 (got 4)"),
+    (["-p", "harris_window=5.5"], "harris_window takes an integer"),
+    (["-p", "harris_nl=100", "-p", "harris_window=5"], "harris harris_nl=100 harris_window=5:"),
+    (["-p", "no_such=1"], "parameter 'no_such' is taken by none of efast, harris"),
+    (["-d", "efast,nope"], "unknown detector 'nope'"),
+])
+def test_bad_options_are_a_usage_error_before_anything_runs(recordings, tmp_path, args, says):
+    out = tmp_path / "out"
+    start = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "evcorner", "batch", *recordings, "-d", "efast,harris", "-o", str(out),
+                        *args], env=env_with_package(), capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2, r.stderr
+    assert says in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr
+    assert not out.exists()  # nothing submitted, nothing written
+    assert time.perf_counter() - start < 30  # no cluster was started
+
+
+def test_a_lost_result_counts_the_finished_task_as_finished(client, recordings, tmp_path):
+    """Futures that end cancelled (as when the scheduler is lost): a task whose JSON was
+    written is counted as finished, one without it as not run, none as failed."""
+    tasks = batch.plan(recordings, ["efast"], tmp_path)
+    futures = batch.submit(client, tasks[:2])
+    distributed.wait(list(futures.values()))
+    futures.update(batch.submit(client, tasks[2:]))
+    client.cancel(list(futures.values()))
+    records = batch.gather(tasks, futures, tmp_path)
+    assert all(f.status == "cancelled" for f in futures.values())
+    for t, r in zip(tasks, records):
+        finished = batch.done(t) is not None
+        assert r["status"] == ("ok" if finished else batch.NOT_RUN), r
+        assert finished or not Path(t["corners"]).exists()
+    assert [r["status"] for r in records[:2]] == ["ok", "ok"] and records[0].get("recovered")
+    assert "FAILED" not in batch.table(records)
+
+
+def test_resume_removes_the_tasks_own_temporary_files_only(client, recordings, tmp_path):
+    tasks = batch.plan(recordings[:1], ["efast", "harris"], tmp_path, params={"harris_window": [5]})
+    d = Path(tasks[0]["dir"])
+    d.mkdir(parents=True)
+    # What a killed worker leaves: run_task's temporaries, the library's hidden file beside
+    # one and beside the corner file, and an earlier version's summary temporary.
+    own = [".efast.evcorner-batch-123-abcd.txt", ".efast.evcorner-batch-123-abcd.json",
+           "..efast.evcorner-batch-123-abcd.txt.evcorner-Ab12Cd", ".efast.txt.evcorner-Zz9Yx8", "efast.json.tmp4242",
+           ".harris_harris_window=5.evcorner-batch-9-ff.txt"]
+    others = [".efast.txt.evcorner-toolong", ".efast_other.evcorner-batch-1-a.txt", "efast.json.tmpx", ".notes",
+              "keep.txt", ".harris.evcorner-batch-9-ff.txt"]
+    for name in own + others:
+        (d / name).write_text("x")
+    records = batch.gather(tasks, batch.submit(client, tasks), tmp_path)
+    assert all(r["status"] == "ok" for r in records)
+    left = sorted(p.name for p in d.iterdir())
+    assert left == sorted(others + [Path(t[k]).name for t in tasks for k in ("corners", "summary")])
+
+
 def test_resume_skips_what_was_done(client, recordings, cli_counts, tmp_path):
     tasks = batch.plan(recordings, DETECTORS, tmp_path)
     # An interrupted batch: only the first three tasks ran.
@@ -182,7 +283,7 @@ def test_external_scheduler_and_two_dask_workers(recordings, cli_counts, tmp_pat
                            env=env, capture_output=True, text=True, timeout=120)
         assert r.returncode == 0, r.stderr
         assert "on 2 workers" in r.stderr
-        assert r.stdout.splitlines()[0].split()[:2] == ["recording", "detector+params"]
+        assert r.stdout.splitlines()[1].split()[:2] == ["input", "detector+params"]
         results = lines(out / "results.jsonl")
         assert len(results) == len(recordings) * len(DETECTORS)
         worker_pids = {p.pid for p in procs[1:]}

@@ -4,7 +4,9 @@
 // format is told from are peeked at and then read by the reader, so pipes, FIFOs and
 // process substitutions (`<(...)`) work like files.
 
+#include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -15,6 +17,23 @@ namespace evcorner::io {
 
 /// The format names open_event_reader() accepts, besides "auto".
 inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat, hdf5, atis-bin, mat, rosbag2, mcap, rosbag";
+
+/// The file-name extensions of the event files open_event_reader() reads, lower case with
+/// the dot: ".txt", ".csv", ".npy", ".aedat", ".aedat2", ".aedat4", ".raw" (EVT 2.0/3.0),
+/// ".dat", ".h5", ".hdf5", ".bin" (ATIS), ".mat", ".bag" (ROS 1), ".db3" (rosbag2 SQLite),
+/// ".mcap". For a program that picks event files out of a folder by name; the reader
+/// itself tells the format by the content.
+std::span<const std::string_view> input_file_extensions() noexcept;
+
+/// The extensions of the compressions text and CSV are read through (".gz", ".zst",
+/// ".bz2", ".xz"), after ".txt" or ".csv".
+std::span<const std::string_view> input_compression_extensions() noexcept;
+
+/// Whether `path` is, by its form, an input open_event_reader() reads: a folder holding
+/// metadata.yaml (a rosbag2 bag), or a file whose extension (case-insensitive) is one of
+/// input_file_extensions(), or ".txt"/".csv" followed by one of
+/// input_compression_extensions(). Only names are looked at, never the contents.
+bool is_event_input_path(const std::filesystem::path& path);
 
 /// Tells the format of `file` from its first bytes, which it only peeks at
 /// (InputFile::peek), so a reader given `file` afterwards reads them too: "aedat2"
