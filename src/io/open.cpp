@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "evcorner/error.hpp"
 #include "evcorner/io/aedat2_reader.hpp"
@@ -15,6 +16,7 @@
 #include "evcorner/io/atis_reader.hpp"
 #include "evcorner/io/csv_reader.hpp"
 #include "evcorner/io/dat_reader.hpp"
+#include "evcorner/io/formats.hpp"
 #include "evcorner/io/evt2_reader.hpp"
 #include "evcorner/io/evt3_reader.hpp"
 #include "evcorner/io/hdf5_events.hpp"
@@ -32,63 +34,59 @@ namespace {
 // Past this many bytes a header is not a header: decide with what was seen.
 constexpr std::size_t kMaxHead = std::size_t{1} << 16;
 
-struct Signature {
-    std::string_view magic;
-    std::string_view format;
-    std::string_view what;
-};
-constexpr std::array<Signature, 4> kSignatures = {{
-    {"#!AER-DAT2.0", "aedat2", "AEDAT 2.0"},
-    {kAedat4Magic, "aedat4", "AEDAT 4.0"},
-    {kHdf5Magic, "hdf5", "HDF5"},
-    {"\x93NUMPY", "npy", ".npy"},
-}};
-
 bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
 
-// Files told by their first bytes beyond the formats above: a reader's format name, or
-// an empty format for a kind evcorner cannot read ("unsupported format: this looks like
-// WHAT", with the hint). Checked in order; `offset` is where the magic stands.
-// (ROS: wt-ros fills in the format names of the bag readers.)
+// The format whose magic (formats.hpp) `head` starts with; nullptr when none.
+const InputFormat* by_magic(std::string_view head) noexcept {
+    for (const InputFormat& f : input_formats())
+        for (const std::string_view m : f.magic)
+            if (!m.empty() && starts_with(head, m)) return &f;
+    return nullptr;
+}
+
+// A format's title up to its first ':', ',' or " (": "AEDAT 2.0", "ROS 2 bag".
+std::string_view short_title(const InputFormat& f) noexcept {
+    return f.title.substr(0, std::min({f.title.find(':'), f.title.find(','), f.title.find(" (")}));
+}
+
+// Files told by their first bytes that no reader takes ("unsupported format: this looks
+// like WHAT", with the hint). Checked in order; `offset` is where the magic stands.
 struct Magic {
     std::size_t offset;
     std::string_view magic;
-    std::string_view format;  // empty: no reader
     std::string_view what;
     std::string_view hint;
 };
 constexpr std::string_view kAny = "";
 const Magic kMagics[] = {
-    {0, "MATLAB 5.0 MAT-file", "mat", "a MATLAB 5.0 MAT-file", kAny},
-    {0, "MATLAB 7.3 MAT-file", "mat", "a MATLAB 7.3 MAT-file", kAny},
-    {0, "#ROSBAG", "", "a ROS bag of an unknown version", kAny},
-    {0, "#!AER-DAT3", "", "an AEDAT 3.x file", "AEDAT 2.0 and 4.0 are read; convert it with the DV software"},
-    {0, "#!AER-DAT", "", "an AEDAT file of an unknown version", "AEDAT 2.0 and 4.0 are read"},
-    {0, "Event Stream", "", "an Event Stream (.es) file", kAny},
-    {0, std::string_view("PK\x03\x04", 4), "", "a zip archive (a .npz?)",
+    {0, "#ROSBAG", "a ROS bag of an unknown version", kAny},
+    {0, "#!AER-DAT3", "an AEDAT 3.x file", "AEDAT 2.0 and 4.0 are read; convert it with the DV software"},
+    {0, "#!AER-DAT", "an AEDAT file of an unknown version", "AEDAT 2.0 and 4.0 are read"},
+    {0, "Event Stream", "an Event Stream (.es) file", kAny},
+    {0, std::string_view("PK\x03\x04", 4), "a zip archive (a .npz?)",
      "unzip it and pass the .npy or text file inside"},
-    {0, std::string_view("PK\x05\x06", 4), "", "an empty zip archive", kAny},
-    {0, std::string_view("\x89PNG\r\n\x1a\n", 8), "", "a PNG image", kAny},
-    {0, std::string_view("\xff\xd8\xff", 3), "", "a JPEG image", kAny},
-    {0, "GIF8", "", "a GIF image", kAny},
-    {0, std::string_view("II*\0", 4), "", "a TIFF image", kAny},
-    {0, std::string_view("MM\0*", 4), "", "a TIFF image", kAny},
-    {0, "%PDF-", "", "a PDF document", kAny},
-    {0, std::string_view("\x7f" "ELF", 4), "", "an ELF executable or library", kAny},
-    {0, std::string_view("7z\xbc\xaf\x27\x1c", 6), "", "a 7-Zip archive", kAny},
-    {0, std::string_view("Rar!\x1a\x07", 6), "", "a RAR archive", kAny},
-    {0, std::string_view("\x04\x22\x4d\x18", 4), "", "an LZ4 frame (compressed data)",
+    {0, std::string_view("PK\x05\x06", 4), "an empty zip archive", kAny},
+    {0, std::string_view("\x89PNG\r\n\x1a\n", 8), "a PNG image", kAny},
+    {0, std::string_view("\xff\xd8\xff", 3), "a JPEG image", kAny},
+    {0, "GIF8", "a GIF image", kAny},
+    {0, std::string_view("II*\0", 4), "a TIFF image", kAny},
+    {0, std::string_view("MM\0*", 4), "a TIFF image", kAny},
+    {0, "%PDF-", "a PDF document", kAny},
+    {0, std::string_view("\x7f" "ELF", 4), "an ELF executable or library", kAny},
+    {0, std::string_view("7z\xbc\xaf\x27\x1c", 6), "a 7-Zip archive", kAny},
+    {0, std::string_view("Rar!\x1a\x07", 6), "a RAR archive", kAny},
+    {0, std::string_view("\x04\x22\x4d\x18", 4), "an LZ4 frame (compressed data)",
      "decompress it first (lz4 -d); gzip, zstd, bzip2 and xz are read directly"},
-    {0, "PAR1", "", "an Apache Parquet file", kAny},
-    {257, "ustar", "", "a tar archive", "extract it and pass the event file inside"},
-    {4, "ftyp", "", "an MP4/MOV video", kAny},
+    {0, "PAR1", "an Apache Parquet file", kAny},
+    {257, "ustar", "a tar archive", "extract it and pass the event file inside"},
+    {4, "ftyp", "an MP4/MOV video", kAny},
 };
 
 // Thrown for a file no reader takes: what it looks like, never its raw bytes.
 [[noreturn]] void unsupported(const InputFile& file, std::string_view what, std::string_view hint) {
     throw InputError(file.name(), "unsupported format: this looks like " + std::string(what) +
                                       (hint.empty() ? std::string() : " (" + std::string(hint) + ")") +
-                                      "; evcorner reads " + std::string(kInputFormats));
+                                      "; evcorner reads " + input_format_names());
 }
 
 // Whether `head` can be the start of a text file: no NUL byte, and few other control
@@ -155,9 +153,8 @@ std::string detect_format(InputFile& file) {
     constexpr std::size_t kLongest = 16;  // covers every signature
     // (A later peek() may move the bytes: `start` is taken again after each.)
     std::string_view start = file.peek(kLongest);
-    if (const std::string_view bag = detect_bag_format(start); !bag.empty()) return std::string(bag);
-    for (const Signature& s : kSignatures)
-        if (starts_with(start, s.magic)) return std::string(s.format);
+    if (const InputFormat* f = by_magic(file.peek(64))) return std::string(f->name);
+    start = file.peek(kLongest);
     if (!file.compression()) {
         if (const auto c = compression_from_magic(start)) {
             // Compressed: text and CSV inside are read through the decompressor.
@@ -186,8 +183,12 @@ std::string detect_format(InputFile& file) {
     if (start.size() < kLongest && start.size() >= 2) {
         // The whole input is a few bytes that begin a signature: a file cut short.
         std::string what;
-        for (const Signature& s : kSignatures)
-            if (starts_with(s.magic, start)) what += (what.empty() ? "" : " or ") + std::string(s.what);
+        for (const InputFormat& f : input_formats())
+            for (const std::string_view m : f.magic)
+                if (!m.empty() && starts_with(m, start)) {
+                    what.append(what.empty() ? "" : " or ").append(short_title(f));
+                    break;
+                }
         if (!what.empty())
             throw InputError(file.name(), InputError::Unit::byte, start.size(),
                              fmt::format("the file ends inside the {} signature: it is cut short", what));
@@ -196,8 +197,7 @@ std::string detect_format(InputFile& file) {
         const std::string_view head = file.peek(512);
         for (const Magic& m : kMagics) {
             if (head.size() < m.offset + m.magic.size() || head.substr(m.offset, m.magic.size()) != m.magic) continue;
-            if (m.format.empty()) unsupported(file, m.what, m.hint);
-            return std::string(m.format);
+            unsupported(file, m.what, m.hint);
         }
         if (starts_with(head, "\xff\xfe") || starts_with(head, "\xfe\xff"))
             unsupported(file, "UTF-16 text", "save it as UTF-8 or ASCII");
@@ -251,10 +251,20 @@ std::string detect_format(const std::string& path) {
 }
 
 std::span<const std::string_view> input_file_extensions() noexcept {
-    static constexpr std::array<std::string_view, 15> kExtensions = {
-        ".txt", ".csv", ".npy", ".aedat", ".aedat2", ".aedat4", ".raw", ".dat",
-        ".h5",  ".hdf5", ".bin", ".mat", ".bag",    ".db3",    ".mcap"};
-    return kExtensions;
+    static const std::vector<std::string_view> extensions = [] {
+        std::vector<std::string_view> all;
+        for (const InputFormat& f : input_formats()) {
+            std::string_view e = f.extensions;
+            while (!e.empty()) {
+                const auto sp = e.find(' ');
+                const std::string_view one = e.substr(0, sp);
+                if (std::find(all.begin(), all.end(), one) == all.end()) all.push_back(one);
+                e.remove_prefix(sp == std::string_view::npos ? e.size() : sp + 1);
+            }
+        }
+        return all;
+    }();
+    return extensions;
 }
 
 std::span<const std::string_view> input_compression_extensions() noexcept {
@@ -294,41 +304,13 @@ std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOp
     InputFile file(path);
     std::string fmt_name(format);
     if (fmt_name == "auto") fmt_name = detect_format(file);
-    constexpr std::array<std::string_view, 14> kNames = {"ecd-text", "text", "csv", "npy",  "aedat2", "aedat",
-                                                         "aedat4",   "evt2", "evt3", "dat", "hdf5",   "h5",
-                                                         "atis-bin", "mat"};
-    if (std::find(kNames.begin(), kNames.end(), fmt_name) == kNames.end() && !is_bag_format(fmt_name))
-        throw InputError(file.name(), "unknown input format '" + fmt_name + "' (known: " + std::string(kInputFormats) + ")");
-    if (!options.aedat2_chip.empty() && fmt_name != "aedat2" && fmt_name != "aedat")
-        throw std::invalid_argument(file.name() + ": a camera chip (--chip) names the address layout of an "
-                                    "AEDAT 2.0 file; this file is " + fmt_name);
-    if (!options.topic.empty() && !is_bag_format(fmt_name))
-        throw std::invalid_argument(file.name() + ": a topic (--topic) names what to read in a ROS bag; this file is " +
-                                    fmt_name);
-    // Bags are read by seeking: the reader opens the path itself.
-    if (is_bag_format(fmt_name)) return open_bag_reader(path, std::move(options), fmt_name);
-    if ((fmt_name == "ecd-text" || fmt_name == "text" || fmt_name == "csv") && !file.compression())
+    const InputFormat* f = find_input_format(fmt_name);
+    if (f == nullptr)
+        throw InputError(file.name(), "unknown input format '" + fmt_name + "' (known: " + input_format_names() + ")");
+    check_reader_options(*f, options, file.name());
+    if (f->compressed && !file.compression())
         if (const auto c = compression_from_magic(file.peek(8))) file.decompress(*c);  // a forced format
-    if (fmt_name == "atis-bin") return std::make_unique<AtisReader>(std::move(file), std::move(options));
-    if (fmt_name == "mat") return std::make_unique<MatReader>(path, std::move(options));
-    if (fmt_name == "ecd-text" || fmt_name == "text") {
-        if (!options.sensor) options.sensor = options.fallback_sensor;
-        return std::make_unique<TextReader>(std::move(file), std::move(options));
-    }
-    if (fmt_name == "aedat2" || fmt_name == "aedat") return std::make_unique<Aedat2Reader>(std::move(file), std::move(options));
-    if (fmt_name == "aedat4") return std::make_unique<Aedat4Reader>(std::move(file), std::move(options));
-    if (fmt_name == "hdf5" || fmt_name == "h5") {
-        // The HDF5 library seeks, and opens the file by its path: only a regular file will do.
-        if (path == "-" || !file.size())
-            throw InputError(file.name(), "HDF5 is read by seeking in a regular file; a pipe or standard input "
-                                          "cannot be read as HDF5 (save it to a file first)");
-        return std::make_unique<Hdf5Reader>(path, std::move(options));
-    }
-    if (fmt_name == "csv") return std::make_unique<CsvReader>(std::move(file), std::move(options));
-    if (fmt_name == "evt3") return std::make_unique<Evt3Reader>(std::move(file), std::move(options));
-    if (fmt_name == "evt2") return std::make_unique<Evt2Reader>(std::move(file), std::move(options));
-    if (fmt_name == "npy") return std::make_unique<NpyReader>(std::move(file), std::move(options));
-    return std::make_unique<DatReader>(std::move(file), std::move(options));
+    return f->open(std::move(file), path, std::move(options));
 }
 
 }  // namespace evcorner::io

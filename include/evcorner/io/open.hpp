@@ -15,7 +15,8 @@
 
 namespace evcorner::io {
 
-/// The format names open_event_reader() accepts, besides "auto".
+/// The format names open_event_reader() accepts, besides "auto" and the aliases: the
+/// names of input_formats() (formats.hpp), in its order (a test holds them equal).
 inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat, hdf5, atis-bin, mat, rosbag2, mcap, rosbag";
 
 /// The file-name extensions of the event files open_event_reader() reads, lower case with
@@ -53,10 +54,11 @@ std::string detect_format(const std::string& path);
 /// Opens `path` ("-" = standard input) with the reader of `format` ("auto": detect).
 /// Formats without sensor metadata (text, files whose header has no geometry) validate
 /// against options.sensor, else options.fallback_sensor (the DAVIS240C's 240x180
-/// unless changed). HDF5 needs a regular file (the HDF5 library seeks and opens the
-/// path itself); every other format reads front to back and works on a pipe.
-/// Throws InputError; std::invalid_argument for options.aedat2_chip on a file that is
-/// not AEDAT 2.0.
+/// unless changed). The formats read by seeking (InputFormat::by_seeking: HDF5, .mat,
+/// ROS bags) need a regular file; every other format reads front to back and works on a
+/// pipe. The format's entry in input_formats() (formats.hpp) opens the reader.
+/// Throws InputError; std::invalid_argument for a reader option the format does not take
+/// (check_reader_options()).
 std::unique_ptr<EventReader> open_event_reader(const std::string& path, ReaderOptions options = {},
                                                std::string_view format = "auto");
 
