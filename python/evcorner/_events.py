@@ -310,9 +310,9 @@ def as_events(array, time_unit=None, columns="t,x,y,p", sensor=None):
     seconds and integer times microseconds; `time_unit` ("s", "ms", "us", "ns") names the
     unit of either. Times are rounded to the nearest microsecond (halves away from zero)
     from at most nanosecond digits: a float time with more than 9 decimals of seconds (6 of
-    milliseconds), a fraction of a microsecond with time_unit="us" or of a nanosecond with
-    "ns", or every time below 1 with time_unit="us" (seconds declared as microseconds) is a
-    ValueError naming time_unit and the rule, never a silent rounding.
+    milliseconds), or a fraction of a microsecond with time_unit="us" (of a nanosecond with
+    "ns") is a ValueError naming time_unit and the rule, never a silent rounding; when every
+    time is below 1 with time_unit="us", it says they look like seconds.
 
     An array with EVENT_DTYPE's layout (EVENT_DTYPE itself, evcorner's .npy dtype with its
     '_' padding field, np.load(..., mmap_mode='r') of one) is returned as a view of the
@@ -380,6 +380,8 @@ def _checked_int(v, name, lo, hi):
 
 def _nearest_us(v, div):
     """Integers `v` in units of 1/div us, to the nearest microsecond, halves away from zero."""
+    if v.min() >= 0:
+        return (v + div // 2) // div  # (a new array: v may be the caller's)
     q, r = np.divmod(v, div)  # floor division: 0 <= r < div
     up = (r > div // 2) | ((r == div // 2) & (v >= 0))
     return q + up
@@ -412,12 +414,15 @@ def _times(t, unit):
         return np.zeros(0, np.int64)
     # Whole units of 1/10**decimals, within the rounding a float of t's type has at its value.
     decimals = _TIME_DECIMALS[unit]
-    scaled = t.astype(np.float64) * 10.0 ** decimals
-    if not (np.abs(scaled).max() < 9.2e18):
+    scaled = np.multiply(t, 10.0 ** decimals, dtype=np.float64)
+    if not (max(scaled.max(), -scaled.min()) < 9.2e18):
         _first_bad(~(np.abs(scaled) < 9.2e18), f"t is out of range in {unit} ({what})", t)
     whole = np.rint(scaled)
-    slack = 4.0 * np.spacing(np.abs(t)).astype(np.float64) * 10.0 ** decimals
-    bad = np.abs(scaled - whole) > slack
+    # The rounding a float of t's type has at the largest time (at most a few ulps, in units).
+    slack = 4.0 * float(np.spacing(t.dtype.type(max(t.max(), -t.min())))) * 10.0 ** decimals
+    np.subtract(scaled, whole, out=scaled)
+    np.abs(scaled, out=scaled)
+    bad = scaled > slack
     if unit == "us" and bad.any() and (np.abs(t) < 1).all():
         raise ValueError(f"as_events: every time is below 1 with time_unit='us' (seconds declared as "
                          f"microseconds?); pass time_unit='s' or leave it None ({_TIME_RULE})")

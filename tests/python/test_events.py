@@ -175,6 +175,10 @@ def test_integer_times_follow_the_unit():
     assert list(evcorner.as_events(a, time_unit="ms")["t"]) == [1499000, 1500000, 2500000, 7000000]
     a["t"] = [-1500, -1499, 0, 1]
     assert list(evcorner.as_events(a, time_unit="ns")["t"]) == [-2, -1, 0, 0]    # halves away from zero
+    assert list(a["t"]) == [-1500, -1499, 0, 1]  # the input is left as it was
+    a["t"] = [1500, 2499, 2500, 7]
+    assert list(evcorner.as_events(a, time_unit="ns")["t"]) == [2, 2, 3, 0]
+    assert list(a["t"]) == [1500, 2499, 2500, 7]
     a["t"] = [0, 1, 2, 2**62]
     with pytest.raises(ValueError, match="event 3: t overflows"):
         evcorner.as_events(a, time_unit="s")
