@@ -316,3 +316,21 @@ def test_format_lists_are_tuples():
     assert {"ecd-text", "csv", "npy", "aedat2", "aedat4", "hdf5"} <= set(evcorner.INPUT_FORMATS)
     assert {"ecd-text", "csv", "npy", "aedat4", "hdf5"} == set(evcorner.OUTPUT_FORMATS)
     assert all(name and name == name.strip() for name in evcorner.INPUT_FORMATS)
+
+
+def test_a_file_cut_short_delivers_its_events_then_the_error(tmp_path):
+    # A binary format: a .npy whose data ends 20 000 events (and 7 bytes) into the 30 000 declared.
+    events = evcorner.read(SAMPLE)
+    path = tmp_path / "cut.npy"
+    evcorner.write(path, events)
+    header = path.stat().st_size - 16 * len(events)
+    with path.open("r+b") as f:
+        f.truncate(header + 16 * 20_000 + 7)
+    chunks = []
+    with pytest.raises(evcorner.InputError, match=r"cut\.npy: byte \d+: the file ends after 20000 of the 30000"):
+        for chunk in evcorner.open(path, n_events=25_000):
+            chunks.append(chunk)
+    assert [len(c) for c in chunks] == [20_000]
+    np.testing.assert_array_equal(chunks[0], events[:20_000])
+    with pytest.warns(RuntimeWarning, match="the file ends after 20000"):
+        np.testing.assert_array_equal(evcorner.read(path, allow_damaged=True), events[:20_000])
