@@ -358,8 +358,18 @@ private:
 /// Damaged input (an InputError from the reader) never costs the events before it: a call
 /// that has gathered events when the error comes returns them, and the error is raised by
 /// the next call (and every one after). With allow_damaged, the error ends the input
-/// instead; damaged() then says what it was.
+/// instead; damaged() then says what it was. One call reads at a time (a lock, taken with
+/// the GIL released): threads sharing a reader get its events in turn, each event once.
 class PyReader {
+    // f() under the lock, taken with the GIL released (a reading thread holds the lock
+    // without the GIL).
+    template <class F>
+    auto locked(F&& f) {
+        py::gil_scoped_release release;
+        const std::lock_guard lock(mutex_);
+        return f();
+    }
+
 public:
     PyReader(const std::string& path, const io::ReaderOptions& options, const std::string& format,
              bool allow_damaged)
@@ -371,6 +381,7 @@ public:
         std::vector<Event> out;
         {
             py::gil_scoped_release release;
+            const std::lock_guard lock(mutex_);
             out.reserve(std::min<std::size_t>(n, std::size_t{1} << 20));
             while (out.size() < n && next(!out.empty())) {
                 const std::size_t take = std::min(n - out.size(), len_ - pos_);
@@ -386,6 +397,7 @@ public:
         std::vector<Event> out;
         {
             py::gil_scoped_release release;
+            const std::lock_guard lock(mutex_);
             while (next(!out.empty())) {
                 std::size_t end = pos_;
                 while (end < len_ && buf_[end].t < t_end) ++end;
@@ -399,23 +411,27 @@ public:
 
     /// The time of the next event, or None at the end.
     py::object peek_time() {
-        bool more = false;
+        std::optional<std::int64_t> t;
         {
             py::gil_scoped_release release;
-            more = next(false);
+            const std::lock_guard lock(mutex_);
+            if (next(false)) t = buf_[pos_].t;
         }
-        if (!more) return py::none();
-        return py::int_(buf_[pos_].t);
+        if (!t) return py::none();
+        return py::int_(*t);
     }
 
-    [[nodiscard]] py::object sensor() const { return size_or_none(reader_->sensor()); }
-    [[nodiscard]] std::string format() const { return std::string(reader_->format()); }
-    [[nodiscard]] std::string name() const { return reader_->name(); }
-    [[nodiscard]] std::uint64_t skipped() const { return reader_->skipped(); }
-    [[nodiscard]] std::uint64_t bytes_consumed() const { return reader_->bytes_consumed(); }
-    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const { return reader_->bytes_total(); }
+    [[nodiscard]] py::object sensor() { return size_or_none(locked([&] { return reader_->sensor(); })); }
+    [[nodiscard]] std::string format() { return locked([&] { return std::string(reader_->format()); }); }
+    [[nodiscard]] std::string name() { return locked([&] { return reader_->name(); }); }
+    [[nodiscard]] std::uint64_t skipped() { return locked([&] { return reader_->skipped(); }); }
+    [[nodiscard]] std::uint64_t bytes_consumed() { return locked([&] { return reader_->bytes_consumed(); }); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() { return locked([&] { return reader_->bytes_total(); }); }
     /// The error that ended the input (allow_damaged), or None.
-    [[nodiscard]] py::object damaged() const { return damaged_.empty() ? py::object(py::none()) : py::str(damaged_); }
+    [[nodiscard]] py::object damaged() {
+        const std::string d = locked([&] { return damaged_; });
+        return d.empty() ? py::object(py::none()) : py::str(d);
+    }
 
 private:
     // fill(), with the rule for damaged input: false at the end; an error is raised now only
@@ -457,6 +473,7 @@ private:
     bool allow_damaged_ = false;
     std::exception_ptr pending_;  ///< the input error the next call raises
     std::string damaged_;
+    std::mutex mutex_;
 };
 
 /// Throws InvalidEvent (naming its index) for the first event off `sensor` or with a

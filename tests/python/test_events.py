@@ -334,3 +334,26 @@ def test_a_file_cut_short_delivers_its_events_then_the_error(tmp_path):
     np.testing.assert_array_equal(chunks[0], events[:20_000])
     with pytest.warns(RuntimeWarning, match="the file ends after 20000"):
         np.testing.assert_array_equal(evcorner.read(path, allow_damaged=True), events[:20_000])
+
+
+def test_threads_sharing_a_file_get_each_event_once():
+    # The reader is read with the GIL released: without its lock, threads sharing it lose,
+    # repeat or corrupt events (or crash).
+    import threading
+    whole = np.sort(evcorner.read(SAMPLE), order=["t", "x", "y", "p"])
+    for _ in range(10):
+        f = evcorner.open(SAMPLE, n_events=37)
+        got = [[] for _ in range(4)]
+
+        def drain(out):
+            for chunk in f:
+                out.append(chunk)
+
+        threads = [threading.Thread(target=drain, args=(g,)) for g in got]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        chunks = [c for g in got for c in g]
+        assert sum(len(c) for c in chunks) == len(whole)
+        np.testing.assert_array_equal(np.sort(np.concatenate(chunks), order=["t", "x", "y", "p"]), whole)
