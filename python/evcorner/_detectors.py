@@ -103,7 +103,7 @@ def simulate(scene):
         events, sensor = _evcorner.simulate(scene, False)
     else:
         events, sensor = _evcorner.simulate(_input_path(scene), True)
-    return _as_recording(events, sensor, "simulated"), sensor
+    return _as_recording(events, sensor), sensor
 
 
 def evaluate_truth(events, corners, truth, radius=3.5, tolerance_us=1000, credit="all", interpolation="linear",

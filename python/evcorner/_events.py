@@ -327,6 +327,9 @@ def as_events(array, time_unit=None, columns="t,x,y,p", sensor=None):
         raise ValueError(f"as_events: time_unit must be one of {', '.join(_TIME_SCALE)} or None (got {time_unit!r})")
     sensor = _size(sensor, "as_events: sensor") if sensor is not None else getattr(array, "sensor", None)
     if array.dtype.names and _has_layout(array.dtype):
+        if time_unit not in (None, "us"):
+            raise ValueError(f"as_events: the array has EVENT_DTYPE's layout, whose times are microseconds; "
+                             f"time_unit={time_unit!r} does not apply")
         if array.ndim != 1:
             raise ValueError(f"as_events: expected a 1-D array of events, got {array.ndim} dimensions")
         if not array.flags.c_contiguous or array.ctypes.data % 8:

@@ -216,6 +216,10 @@ def test_float_times_that_cannot_follow_the_rule_are_errors(times, unit, message
 def test_as_events_refuses_an_unknown_unit():
     with pytest.raises(ValueError, match="time_unit must be one of"):
         evcorner.as_events(np.zeros((1, 4)), time_unit="sec")
+    events = evcorner.read(SAMPLE)[:3]
+    assert evcorner.as_events(events, time_unit="us") is not None
+    with pytest.raises(ValueError, match="times are microseconds; time_unit='ns' does not apply"):
+        evcorner.as_events(events, time_unit="ns")
 
 
 # evcorner's own .npy (t, x, y, p, '_' V3), loaded and memory-mapped: read in place.
