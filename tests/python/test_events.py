@@ -134,14 +134,6 @@ def test_as_events_refuses_bad_values():
         evcorner.as_events([1, 2, 3])
 
 
-def test_numpy_operations_keep_the_layout():
-    events = evcorner.read(SAMPLE)[:100]
-    assert evcorner.EVENT_DTYPE.isalignedstruct
-    for joined in (np.concatenate([events, events]), np.hstack([events, events]), np.append(events, events)):
-        assert joined.dtype == evcorner.EVENT_DTYPE and joined.dtype.itemsize == 16
-        evcorner.EFast(240, 180).process(joined)
-
-
 # Times: float = seconds, integer = microseconds, unless time_unit names the unit.
 
 def test_float_times_of_a_text_file_are_seconds_as_the_cli_reads_them(cli, tmp_path):
@@ -361,3 +353,11 @@ def test_threads_sharing_a_file_get_each_event_once():
         chunks = [c for g in got for c in g]
         assert sum(len(c) for c in chunks) == len(whole)
         np.testing.assert_array_equal(np.sort(np.concatenate(chunks), order=["t", "x", "y", "p"]), whole)
+
+
+def test_numpy_operations_keep_the_layout():
+    events = evcorner.read(SAMPLE)[:100]
+    assert evcorner.EVENT_DTYPE.isalignedstruct
+    for joined in (np.concatenate([events, events]), np.hstack([events, events]), np.append(events, events)):
+        assert joined.dtype == evcorner.EVENT_DTYPE and joined.dtype.itemsize == 16
+        evcorner.EFast(240, 180).process(joined)
