@@ -416,10 +416,13 @@ def _times(t, unit):
     if len(t) == 0:
         return np.zeros(0, np.int64)
     # Whole units of 1/10**decimals, within the rounding a float of t's type has at its value.
+    # |t| of 9e18 microseconds (9e12 s) or more is out of range, as for the C++ readers.
+    if not (max(float(t.max()), -float(t.min())) * _TIME_SCALE[unit] < 9e18):
+        _first_bad(~(np.abs(t.astype(np.float64) * _TIME_SCALE[unit]) < 9e18),
+                   f"t is out of range: |t| must be below 9e18 us ({what})", t)
     decimals = _TIME_DECIMALS[unit]
     scaled = np.multiply(t, 10.0 ** decimals, dtype=np.float64)
-    if not (max(scaled.max(), -scaled.min()) < 9.2e18):
-        _first_bad(~(np.abs(scaled) < 9.2e18), f"t is out of range in {unit} ({what})", t)
+    exact = max(scaled.max(), -scaled.min()) < 9.2e18  # whole units fit int64
     whole = np.rint(scaled)
     # The rounding a float of t's type has at the largest time (at most a few ulps, in units).
     slack = 4.0 * float(np.spacing(t.dtype.type(max(t.max(), -t.min())))) * 10.0 ** decimals
@@ -434,6 +437,9 @@ def _times(t, unit):
                   "us": "a fraction of a microsecond", "ns": "a fraction of a nanosecond"}[unit]
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(f"as_events: event {i}: t = {t[i]!r} has {digits} ({what}; {_TIME_RULE})")
+    if not exact:  # beyond 292 years of nanoseconds a float holds no nanosecond digits
+        us = t.astype(np.float64) * _TIME_SCALE[unit]
+        return np.trunc(us + np.copysign(0.5, us)).astype(np.int64)  # halves away from zero
     v = whole.astype(np.int64)  # nanoseconds, or whole microseconds for "us"
     per_us = round(10 ** decimals / _TIME_SCALE[unit])  # 1000 units a microsecond, or 1 for "us"
     return v if per_us == 1 else _nearest_us(v, per_us)

@@ -183,6 +183,8 @@ def test_float_times_in_a_named_unit():
     assert list(evcorner.as_events(plain, time_unit="us")["t"]) == [3, 4]
     plain[:, 0] = [1500.0, 2499.0]
     assert list(evcorner.as_events(plain, time_unit="ns")["t"]) == [2, 2]
+    plain[:, 0] = [1e10, -8.9e12]  # seconds beyond int64 nanoseconds, within int64 microseconds
+    assert list(evcorner.as_events(plain)["t"]) == [10**16, -89 * 10**17]
     f32 = np.zeros(2, [("t", "<f4"), ("x", "<u2"), ("y", "<u2"), ("p", "u1")])
     f32["t"] = [0.5, 0.25]  # float32 seconds: within its own precision
     assert list(evcorner.as_events(f32)["t"]) == [500000, 250000]
@@ -196,6 +198,7 @@ def test_float_times_in_a_named_unit():
     ([1.5, 2.0], "ns", r"event 0: t = 1\.5 has a fraction of a nanosecond"),
     ([1.0, 1.00000012], "ms", r"event 1: .* more than 6 decimals of milliseconds"),
     ([1.0, np.nan], None, r"event 1: t is not a finite number"),
+    ([1.0, -9.1e12], None, r"event 1: t is out of range: \|t\| must be below 9e18 us \(time_unit=None"),
 ])
 def test_float_times_that_cannot_follow_the_rule_are_errors(times, unit, message):
     plain = np.array([[t, 1, 2, 1] for t in times])
