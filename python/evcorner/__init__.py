@@ -1,11 +1,12 @@
 """evcorner: corner detection on event-camera streams, over numpy arrays without copies.
 
 Events are numpy structured arrays of ``EVENT_DTYPE`` (t int64 microseconds, x, y uint16,
-p uint8; 16 bytes, the C++ ``evcorner::Event``), which the C++ library reads in place.
+p uint8; 16 bytes, the C++ ``evcorner::Event``), which the C++ library reads in place;
+``evcorner.Events`` (what read() returns) is such an array that carries its sensor size.
 
     import evcorner
     events = evcorner.read("events.txt")                    # every format the CLI reads
-    mask = evcorner.detect(events, "harris", harris_window=7)
+    mask = evcorner.detect(events, "harris", harris_window=7)  # on events.sensor
     corners = events[mask.view(bool)]
     det = evcorner.EFast(240, 180)                          # stateful: chunk by chunk
     for chunk in evcorner.open("events.txt", n_events=100_000):
@@ -28,7 +29,7 @@ from ._evcorner import (
     ft_percent,
     reduction_rate,
 )
-from ._events import EventFile, as_events, open, read, write  # noqa: A004 (open, like io.open)
+from ._events import EventFile, Events, as_events, open, read, write  # noqa: A004 (open, like io.open)
 from ._detectors import DETECTOR_CLASSES, detect, detect_file, detectors, evaluate_truth, label, simulate
 
 __version__ = "0.1.0"
@@ -43,6 +44,7 @@ __all__ = [
     "OUTPUT_FORMATS",
     "Detector",
     "EventFile",
+    "Events",
     "InputError",
     "InvalidEvent",
     "OutputError",

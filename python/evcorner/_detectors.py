@@ -6,7 +6,7 @@ import numpy as np
 
 from . import _evcorner
 from ._evcorner import Detector
-from ._events import _input_path, _size, reader_options
+from ._events import _as_recording, _input_path, _size, reader_options
 
 #: The DAVIS240C, the sensor the CLI assumes for formats without one (text, CSV).
 DAVIS240 = (240, 180)
@@ -48,10 +48,13 @@ def _make_class(info):
 DETECTOR_CLASSES = {info["class_name"]: _make_class(info) for info in _evcorner.detectors()}
 
 
-def detect(events, detector="efast", sensor=DAVIS240, scores=False, out=None, **params):
+def detect(events, detector="efast", sensor=None, scores=False, out=None, **params):
     """Runs `detector` (a registry name) over EVENT_DTYPE `events` in one call, read in
     place: returns the uint8 mask (1 = corner), or (mask, scores) with scores=True.
-    `sensor` = (width, height), the DAVIS240C's 240x180 by default as in the CLI."""
+    `sensor` = (width, height); None: the one the events carry (evcorner.Events, e.g. from
+    read()), else the DAVIS240C's 240x180 as in the CLI."""
+    if sensor is None:
+        sensor = getattr(events, "sensor", None) or DAVIS240
     w, h = _size(sensor, "sensor")
     det = Detector(detector, w, h, params)
     if scores:
@@ -95,10 +98,12 @@ def label(corners, **ft_params):
 
 def simulate(scene):
     """Simulates a scene (a JSON file path, or JSON text starting with '{'; docs/simulate.md):
-    returns (events, (width, height))."""
+    returns (events, (width, height)), the events an evcorner.Events carrying that sensor."""
     if isinstance(scene, str) and scene.lstrip().startswith("{"):
-        return _evcorner.simulate(scene, False)
-    return _evcorner.simulate(_input_path(scene), True)
+        events, sensor = _evcorner.simulate(scene, False)
+    else:
+        events, sensor = _evcorner.simulate(_input_path(scene), True)
+    return _as_recording(events, sensor), sensor
 
 
 def evaluate_truth(events, corners, truth, radius=3.5, tolerance_us=1000, credit="all", interpolation="linear",

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
+#include <iterator>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -72,6 +74,56 @@ std::string text_of(py::handle h) { return std::string(py::str(h)); }
 
 std::string type_name(py::handle h) { return py::str(py::type::handle_of(h).attr("__name__")); }
 
+/// Whether a dtype lays its events out exactly as evcorner::Event: 16 bytes, t <i8 at 0,
+/// x <u2 at 8, y <u2 at 10, p u1 at 12, and any other fields inside the padding (bytes
+/// 13..15). EVENT_DTYPE is one; the .npy files evcorner writes (t, x, y, p, '_' V3) are
+/// another, so that np.load() of them, memory-mapped or not, is read in place.
+bool has_event_layout(const py::dtype& dt) {
+    if (dt.ptr() == event_dtype().ptr()) return true;
+    // The last dtype found to have the layout: np.load() makes a new dtype object per file,
+    // and a chunked loop passes views of one array again and again. (The GIL guards it.)
+    static PyObject* last_accepted = nullptr;
+    if (dt.ptr() == last_accepted) return true;
+    if (dt.itemsize() != static_cast<py::ssize_t>(sizeof(Event))) return false;
+    const py::object fields = dt.attr("fields");
+    if (fields.is_none()) return false;
+    const py::dict f(fields);  // (a mappingproxy, copied into a dict)
+    struct Want {
+        const char* name;
+        py::dtype type;  // native (little-endian) order, as Event's
+        std::size_t offset;
+    };
+    const Want wants[] = {{"t", py::dtype::of<std::int64_t>(), offsetof(Event, t)},
+                          {"x", py::dtype::of<std::uint16_t>(), offsetof(Event, x)},
+                          {"y", py::dtype::of<std::uint16_t>(), offsetof(Event, y)},
+                          {"p", py::dtype::of<std::uint8_t>(), offsetof(Event, p)}};
+    std::size_t found = 0;
+    for (const auto& [name, spec] : f) {
+        // fields maps each name (and each title) to (dtype, offset[, title]).
+        const auto entry = py::reinterpret_borrow<py::tuple>(spec);
+        const auto field_type = entry[0].cast<py::dtype>();
+        const auto offset = entry[1].cast<std::size_t>();
+        const std::string n = py::str(name);
+        const Want* want = nullptr;
+        for (const Want& w : wants)
+            if (n == w.name) want = &w;
+        if (want != nullptr) {
+            if (offset != want->offset) return false;
+            if (PyObject_RichCompareBool(field_type.ptr(), want->type.ptr(), Py_EQ) != 1) return false;
+            ++found;
+        } else if (offset < offsetof(Event, p) + sizeof(Event::p) ||
+                   offset + static_cast<std::size_t>(field_type.itemsize()) > sizeof(Event) ||
+                   field_type.attr("hasobject").cast<bool>()) {
+            return false;  // a field that overlaps an event field or is not plain bytes
+        }
+    }
+    if (found != std::size(wants)) return false;
+    Py_XDECREF(last_accepted);
+    last_accepted = dt.ptr();
+    Py_INCREF(last_accepted);
+    return true;
+}
+
 /// The events of `obj` in place, or an exception saying why not.
 std::span<const Event> events_view(py::handle obj, const char* what = "events") {
     if (!py::isinstance<py::array>(obj))
@@ -79,14 +131,11 @@ std::span<const Event> events_view(py::handle obj, const char* what = "events") 
                              type_name(obj));
     const auto a = py::reinterpret_borrow<py::array>(obj);
     const py::dtype dt = a.dtype();
-    if (dt.ptr() != event_dtype().ptr()) {
-        const int same = PyObject_RichCompareBool(dt.ptr(), event_dtype().ptr(), Py_EQ);
-        if (same < 0) throw py::error_already_set();
-        if (same == 0)
-            throw py::type_error(std::string(what) + ": dtype " + text_of(dt) +
-                                 " is not evcorner.EVENT_DTYPE " + text_of(event_dtype()) +
-                                 "; convert it with evcorner.as_events(array) (one copy)");
-    }
+    if (!has_event_layout(dt))
+        throw py::type_error(std::string(what) + ": dtype " + text_of(dt) + " is not evcorner.EVENT_DTYPE " +
+                             text_of(event_dtype()) +
+                             " (nor another with its layout, such as that of evcorner's .npy files); convert it "
+                             "with evcorner.as_events(array) (one copy)");
     if (a.ndim() != 1)
         throw py::value_error(std::string(what) + ": expected a 1-D array, got " + std::to_string(a.ndim()) +
                               " dimensions");
@@ -121,6 +170,20 @@ py::array_t<T> output_array(py::handle out, std::size_t n, const char* what) {
     if (static_cast<std::size_t>(a.shape(0)) == n) return py::reinterpret_borrow<py::array_t<T>>(out);
     return py::reinterpret_steal<py::array_t<T>>(
         PySequence_GetSlice(out.ptr(), 0, static_cast<Py_ssize_t>(n)));
+}
+
+/// A list of format names ("a, b, c") as a tuple of names.
+py::tuple format_names(std::string_view list) {
+    py::list names;
+    while (!list.empty()) {
+        const std::size_t comma = list.find(',');
+        std::string_view name = list.substr(0, comma);
+        while (!name.empty() && name.front() == ' ') name.remove_prefix(1);
+        while (!name.empty() && name.back() == ' ') name.remove_suffix(1);
+        if (!name.empty()) names.append(py::str(std::string(name)));
+        list = comma == std::string_view::npos ? std::string_view{} : list.substr(comma + 1);
+    }
+    return py::tuple(names);
 }
 
 /// Hands a vector of events to numpy without copying it.
@@ -291,17 +354,36 @@ private:
 };
 
 /// An open event file, read in chunks (by count or up to a time) in constant memory.
+///
+/// Damaged input (an InputError from the reader) never costs the events before it: a call
+/// that has gathered events when the error comes returns them, and the error is raised by
+/// the next call (and every one after). With allow_damaged, the error ends the input
+/// instead; damaged() then says what it was. One call reads at a time (a lock, taken with
+/// the GIL released): threads sharing a reader get its events in turn, each event once.
 class PyReader {
+    // f() under the lock, taken with the GIL released (a reading thread holds the lock
+    // without the GIL).
+    template <class F>
+    auto locked(F&& f) {
+        py::gil_scoped_release release;
+        const std::lock_guard lock(mutex_);
+        return f();
+    }
+
 public:
-    PyReader(const std::string& path, const io::ReaderOptions& options, const std::string& format)
-        : reader_(io::open_event_reader(path, options, format)), buf_(std::size_t{1} << 16) {}
+    PyReader(const std::string& path, const io::ReaderOptions& options, const std::string& format,
+             bool allow_damaged)
+        : reader_(io::open_event_reader(path, options, format)),
+          buf_(std::size_t{1} << 16),
+          allow_damaged_(allow_damaged) {}
 
     py::array read_count(std::size_t n) {
         std::vector<Event> out;
         {
             py::gil_scoped_release release;
+            const std::lock_guard lock(mutex_);
             out.reserve(std::min<std::size_t>(n, std::size_t{1} << 20));
-            while (out.size() < n && fill()) {
+            while (out.size() < n && next(!out.empty())) {
                 const std::size_t take = std::min(n - out.size(), len_ - pos_);
                 out.insert(out.end(), buf_.begin() + pos_, buf_.begin() + pos_ + take);
                 pos_ += take;
@@ -315,7 +397,8 @@ public:
         std::vector<Event> out;
         {
             py::gil_scoped_release release;
-            while (fill()) {
+            const std::lock_guard lock(mutex_);
+            while (next(!out.empty())) {
                 std::size_t end = pos_;
                 while (end < len_ && buf_[end].t < t_end) ++end;
                 out.insert(out.end(), buf_.begin() + pos_, buf_.begin() + end);
@@ -328,23 +411,51 @@ public:
 
     /// The time of the next event, or None at the end.
     py::object peek_time() {
-        bool more = false;
+        std::optional<std::int64_t> t;
         {
             py::gil_scoped_release release;
-            more = fill();
+            const std::lock_guard lock(mutex_);
+            if (next(false)) t = buf_[pos_].t;
         }
-        if (!more) return py::none();
-        return py::int_(buf_[pos_].t);
+        if (!t) return py::none();
+        return py::int_(*t);
     }
 
-    [[nodiscard]] py::object sensor() const { return size_or_none(reader_->sensor()); }
-    [[nodiscard]] std::string format() const { return std::string(reader_->format()); }
-    [[nodiscard]] std::string name() const { return reader_->name(); }
-    [[nodiscard]] std::uint64_t skipped() const { return reader_->skipped(); }
-    [[nodiscard]] std::uint64_t bytes_consumed() const { return reader_->bytes_consumed(); }
-    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const { return reader_->bytes_total(); }
+    [[nodiscard]] py::object sensor() { return size_or_none(locked([&] { return reader_->sensor(); })); }
+    [[nodiscard]] std::string format() { return locked([&] { return std::string(reader_->format()); }); }
+    [[nodiscard]] std::string name() { return locked([&] { return reader_->name(); }); }
+    [[nodiscard]] std::uint64_t skipped() { return locked([&] { return reader_->skipped(); }); }
+    [[nodiscard]] std::uint64_t bytes_consumed() { return locked([&] { return reader_->bytes_consumed(); }); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() { return locked([&] { return reader_->bytes_total(); }); }
+    /// The error that ended the input (allow_damaged), or None.
+    [[nodiscard]] py::object damaged() {
+        const std::string d = locked([&] { return damaged_; });
+        return d.empty() ? py::object(py::none()) : py::str(d);
+    }
 
 private:
+    // fill(), with the rule for damaged input: false at the end; an error is raised now only
+    // when the caller holds no events (`holding` false), else kept for the next call.
+    bool next(bool holding) {
+        if (pending_) {
+            if (holding) return false;
+            std::rethrow_exception(pending_);
+        }
+        try {
+            return fill();
+        } catch (const InputError& e) {
+            if (allow_damaged_) {
+                damaged_ = e.what();
+                done_ = true;
+                pos_ = len_ = 0;
+                return false;
+            }
+            pending_ = std::current_exception();
+            if (holding) return false;
+            throw;
+        }
+    }
+
     // Makes buf_[pos_] the next event; false at the end.
     bool fill() {
         while (pos_ == len_ && !done_) {
@@ -359,14 +470,30 @@ private:
     std::vector<Event> buf_;
     std::size_t pos_ = 0, len_ = 0;
     bool done_ = false;
+    bool allow_damaged_ = false;
+    std::exception_ptr pending_;  ///< the input error the next call raises
+    std::string damaged_;
+    std::mutex mutex_;
 };
+
+/// Throws InvalidEvent (naming its index) for the first event off `sensor` or with a
+/// polarity other than 0/1: what a writer recording that sensor must refuse.
+void check_on_sensor(std::span<const Event> ev, std::pair<int, int> sensor) {
+    if (sensor.first < 1 || sensor.second < 1 || sensor.first > 65536 || sensor.second > 65536)
+        throw py::value_error("sensor: " + std::to_string(sensor.first) + "x" + std::to_string(sensor.second) +
+                              " is not a size of 1..65536 x 1..65536");
+    check_events(ev, EventLimits{SensorSize{sensor.first, sensor.second}});
+}
 
 void write_events(const std::string& path, py::handle events, const std::string& format,
                   std::optional<std::pair<int, int>> sensor) {
     const std::span<const Event> ev = events_view(events);
     py::gil_scoped_release release;
     std::optional<SensorSize> size;
-    if (sensor) size = SensorSize{sensor->first, sensor->second};
+    if (sensor) {
+        check_on_sensor(ev, *sensor);  // before the file is created
+        size = SensorSize{sensor->first, sensor->second};
+    }
     auto writer = io::open_event_writer(path, format, size);
     writer->write(ev);
     writer->close();
@@ -579,8 +706,8 @@ PYBIND11_MODULE(_evcorner, m) {
     m.def("_address", [](py::handle events) { return reinterpret_cast<std::uintptr_t>(events_view(events).data()); },
           "Where C++ reads the events of an array (checked as every verb checks it).");
     m.def("detectors", &detector_list, "Every registered detector: name, class_name, summary, has_score, params.");
-    m.attr("INPUT_FORMATS") = std::string(io::kInputFormats);
-    m.attr("OUTPUT_FORMATS") = std::string(io::kOutputFormats);
+    m.attr("INPUT_FORMATS") = format_names(io::kInputFormats);
+    m.attr("OUTPUT_FORMATS") = format_names(io::kOutputFormats);
 
     py::class_<PyDetector>(m, "Detector")
         .def(py::init<std::string, int, int, py::dict>(), py::arg("name"), py::arg("width"), py::arg("height"),
@@ -613,8 +740,8 @@ PYBIND11_MODULE(_evcorner, m) {
         .def_readwrite("topic", &io::ReaderOptions::topic);
 
     py::class_<PyReader>(m, "Reader")
-        .def(py::init<const std::string&, const io::ReaderOptions&, const std::string&>(), py::arg("path"),
-             py::arg("options"), py::arg("format") = "auto")
+        .def(py::init<const std::string&, const io::ReaderOptions&, const std::string&, bool>(), py::arg("path"),
+             py::arg("options"), py::arg("format") = "auto", py::arg("allow_damaged") = false)
         .def("read_count", &PyReader::read_count, py::arg("n"))
         .def("read_until", &PyReader::read_until, py::arg("t_end"))
         .def("peek_time", &PyReader::peek_time)
@@ -623,8 +750,19 @@ PYBIND11_MODULE(_evcorner, m) {
         .def_property_readonly("name", &PyReader::name)
         .def_property_readonly("skipped", &PyReader::skipped)
         .def_property_readonly("bytes_consumed", &PyReader::bytes_consumed)
-        .def_property_readonly("bytes_total", &PyReader::bytes_total);
+        .def_property_readonly("bytes_total", &PyReader::bytes_total)
+        .def_property_readonly("damaged", &PyReader::damaged);
 
+    m.def(
+        "_check_events",
+        [](py::handle events, std::pair<int, int> sensor) {
+            const std::span<const Event> ev = events_view(events);
+            py::gil_scoped_release release;
+            check_on_sensor(ev, sensor);
+        },
+        py::arg("events"), py::arg("sensor"), "InvalidEvent for the first event off sensor=(width, height).");
+    m.def("_has_event_layout", [](const py::dtype& dt) { return has_event_layout(dt); }, py::arg("dtype"),
+          "Whether C++ reads arrays of this dtype in place (EVENT_DTYPE's layout).");
     m.def("write", &write_events, py::arg("path"), py::arg("events"), py::arg("format") = "auto",
           py::arg("sensor") = py::none());
     m.def("detect_file", &detect_file_py, py::arg("input"), py::arg("output"), py::arg("detector"),
