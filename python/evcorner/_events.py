@@ -10,19 +10,13 @@ import numpy as np
 from . import _evcorner
 from ._evcorner import EVENT_DTYPE
 
-#: Keyword arguments of read() / open() / detect_file(reader_options=...): the CLI's reader options.
+#: Keyword arguments of read() / open() / detect_file(reader_options=...): the checks, then the
+#: CLI's reader options by the library's table (help(evcorner._evcorner.ReaderOptions) tells each).
 READER_OPTIONS = (
     "sensor",           # (width, height) or "WxH": validate against this, overriding the file's metadata
     "fallback_sensor",  # when neither sensor nor the file gives one (default (240, 180)); None: no check
     "skip_invalid",     # skip (and count) events outside the sensor instead of failing
-    "csv_columns",      # CSV column order, e.g. "x,y,p,t"
-    "aedat2_chip",      # AEDAT 2.0 camera (jAER chip name)
-    "time_unit",        # CSV t column / .npy / .mat time unit: "us", "ns", "ms", "s"
-    "npy_columns",      # meaning of a plain (N, 4) .npy array's columns
-    "mat_var",          # MATLAB variable
-    "mat_columns",      # its columns
-    "topic",            # ROS bag topic
-)
+) + _evcorner.READER_OPTION_KEYWORDS
 
 
 def _size(value, what):

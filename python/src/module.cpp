@@ -34,6 +34,7 @@
 #include "evcorner/event_check.hpp"
 #include "evcorner/io/event_reader.hpp"
 #include "evcorner/io/event_writer.hpp"
+#include "evcorner/io/formats.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/pipeline/detect.hpp"
 #include "evcorner/registry.hpp"
@@ -706,7 +707,7 @@ PYBIND11_MODULE(_evcorner, m) {
     m.def("_address", [](py::handle events) { return reinterpret_cast<std::uintptr_t>(events_view(events).data()); },
           "Where C++ reads the events of an array (checked as every verb checks it).");
     m.def("detectors", &detector_list, "Every registered detector: name, class_name, summary, has_score, params.");
-    m.attr("INPUT_FORMATS") = format_names(io::kInputFormats);
+    m.attr("INPUT_FORMATS") = format_names(io::input_format_names());
     m.attr("OUTPUT_FORMATS") = format_names(io::kOutputFormats);
 
     py::class_<PyDetector>(m, "Detector")
@@ -729,15 +730,17 @@ PYBIND11_MODULE(_evcorner, m) {
     reader_options.def(py::init<>());
     def_size_property<&io::ReaderOptions::sensor>(reader_options, "sensor");
     def_size_property<&io::ReaderOptions::fallback_sensor>(reader_options, "fallback_sensor");
-    reader_options
-        .def_readwrite("skip_invalid", &io::ReaderOptions::skip_invalid)
-        .def_readwrite("csv_columns", &io::ReaderOptions::csv_columns)
-        .def_readwrite("aedat2_chip", &io::ReaderOptions::aedat2_chip)
-        .def_readwrite("time_unit", &io::ReaderOptions::csv_time_unit)
-        .def_readwrite("npy_columns", &io::ReaderOptions::npy_columns)
-        .def_readwrite("mat_var", &io::ReaderOptions::mat_var)
-        .def_readwrite("mat_columns", &io::ReaderOptions::mat_columns)
-        .def_readwrite("topic", &io::ReaderOptions::topic);
+    reader_options.def_readwrite("skip_invalid", &io::ReaderOptions::skip_invalid);
+    // The user-set options, by their keywords in the library's table (io/formats.hpp).
+    py::list keywords;
+    for (const io::ReaderOptionInfo& info : io::reader_option_infos()) {
+        const io::ReaderOptionInfo* r = &info;
+        reader_options.def_property(
+            std::string(r->keyword).c_str(), [r](const io::ReaderOptions& o) { return r->get(o); },
+            [r](io::ReaderOptions& o, std::string v) { r->set(o, std::move(v)); }, std::string(r->help).c_str());
+        keywords.append(std::string(r->keyword));
+    }
+    m.attr("READER_OPTION_KEYWORDS") = py::tuple(keywords);
 
     py::class_<PyReader>(m, "Reader")
         .def(py::init<const std::string&, const io::ReaderOptions&, const std::string&, bool>(), py::arg("path"),

@@ -89,7 +89,7 @@ const std::array<ReaderOptionInfo, 7> kReaderOptions = {{
     {kOptNpyColumns, "--npy-columns", "npy_columns",
      "A plain (N, 4) .npy array's column order, e.g. x,y,p,t ('_' skips one) [default: t,x,y,p]",
      [](const ReaderOptions& o) { return o.npy_columns; }, [](ReaderOptions& o, std::string v) { o.npy_columns = std::move(v); }},
-    {kOptChip, "--chip", "chip",
+    {kOptChip, "--chip", "aedat2_chip",
      "AEDAT 2.0: the camera that recorded the file (DVS128, DAVIS240C, DAVIS346, ...), instead of the header's "
      "'# AEChip' line",
      [](const ReaderOptions& o) { return o.aedat2_chip; }, [](ReaderOptions& o, std::string v) { o.aedat2_chip = std::move(v); }},
