@@ -13,6 +13,7 @@ resumes a batch (finished tasks are skipped).
 import argparse
 import logging
 import os
+import signal
 import sys
 import time
 
@@ -102,9 +103,15 @@ def _run(args, tasks, batch):
             elif args.scheduler_file:
                 client = Client(scheduler_file=args.scheduler_file, timeout=30)
             else:
-                cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=":0", silence_logs=logging.INFO if args.verbose
-                                       else logging.CRITICAL)
+                # The worker processes ignore SIGINT (they inherit that): Ctrl-C reaches the
+                # whole process group, and it is this process that stops them, in order.
+                previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+                try:
+                    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                                           dashboard_address=":0", silence_logs=logging.INFO if args.verbose
+                                           else logging.CRITICAL)
+                finally:
+                    signal.signal(signal.SIGINT, previous)
                 client = Client(cluster)
         except OSError as e:
             _say(f"cannot reach the scheduler {args.scheduler or args.scheduler_file}: {e}")

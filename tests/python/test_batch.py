@@ -3,6 +3,7 @@
 files, and resuming an interrupted batch. Every process a test starts is on 127.0.0.1 and
 stopped at its end (its process group killed), failed or not."""
 
+import contextlib
 import json
 import os
 import signal
@@ -221,31 +222,38 @@ def test_resume_skips_what_was_done(client, recordings, cli_counts, tmp_path):
 
 
 def test_cli_interrupted_then_resumed(recordings, cli_counts, tmp_path):
-    """Interrupts `python3 -m evcorner batch` (SIGINT) once a result is logged, then reruns it."""
+    """Interrupts `python3 -m evcorner batch` (SIGINT to its process group, as Ctrl-C does)
+    once a result is logged: it stops at once, says so in one line (exit 130), leaves no
+    temporary file and no corner file without its JSON; then reruns it to completion."""
     out = tmp_path / "out"
-    inputs = recordings * 1
-    cmd = [sys.executable, "-m", "evcorner", "batch", *inputs, "-d", ",".join(DETECTORS), "-o", str(out),
-           "--workers", "1", "-p", "harris_window=5,7,9"]
+    windows = [5, 7, 9, 11, 13, 15]
+    cmd = [sys.executable, "-m", "evcorner", "batch", *recordings, "-d", ",".join(DETECTORS), "-o", str(out),
+           "--workers", "1", "-p", "harris_window=" + ",".join(map(str, windows))]
     proc = subprocess.Popen(cmd, env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            start_new_session=True)
+                            start_new_session=True, text=True)
     log = out / "results.jsonl"
-    deadline = time.time() + 60
-    while time.time() < deadline and proc.poll() is None:
-        if log.exists() and log.read_text().count("\n") >= 1:
-            break
-        time.sleep(0.02)
-    if proc.poll() is None:
-        os.killpg(proc.pid, signal.SIGINT)
     try:
-        proc.communicate(timeout=60)
+        deadline = time.time() + 60
+        while time.time() < deadline and proc.poll() is None:
+            if log.exists() and log.read_text().count("\n") >= 1:
+                break
+            time.sleep(0.02)
+        assert proc.poll() is None, "the batch ended before it could be interrupted"
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
     finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
-    total = len(recordings) * (1 + 3)
-    done_before = len(list(out.rglob("*.json")))
-    assert 1 <= done_before <= total
-    rerun = subprocess.run(cmd, env=env_with_package(), capture_output=True, text=True, timeout=120)
+        stop_group(proc)
+    total = len(recordings) * (1 + len(windows))
+    assert proc.returncode == 130, err
+    assert "interrupted: " in err and "rerun the same command to resume" in err, err
+    assert "Traceback" not in err, err
+    assert not [p for p in out.rglob(".*")], "temporary files left"
+    corners = {p.with_suffix("") for p in out.rglob("*.txt")}
+    summaries = {p.with_suffix("") for p in out.rglob("*.json")}
+    assert corners == summaries
+    done_before = len(summaries)
+    assert 1 <= done_before < total
+    rerun = subprocess.run(cmd, env=env_with_package(), capture_output=True, text=True, timeout=300)
     assert rerun.returncode == 0, rerun.stderr
     assert f"({done_before} done before)" in rerun.stderr
     assert rerun.stdout.count("ok (resumed)") == done_before
@@ -253,6 +261,20 @@ def test_cli_interrupted_then_resumed(recordings, cli_counts, tmp_path):
         if r["detector"] == "efast":
             assert r["corners"] == cli_counts[(r["input"], "efast")]
     assert len({r["task"] for r in lines(log)}) == total
+
+
+def stop_group(proc, sig=signal.SIGTERM):
+    """Stops `proc` and everything in its process group (started with start_new_session)."""
+    for s in (sig, signal.SIGKILL):
+        if proc.poll() is not None:
+            break
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, s)
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            proc.wait(timeout=20)
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(proc.pid, signal.SIGKILL)  # what the leader left behind in its group
+    proc.wait()
 
 
 def test_external_scheduler_and_two_dask_workers(recordings, cli_counts, tmp_path):
