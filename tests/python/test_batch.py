@@ -322,3 +322,63 @@ def test_external_scheduler_and_two_dask_workers(recordings, cli_counts, tmp_pat
                 p.kill()
                 p.wait()
     assert all(p.poll() is not None for p in procs)
+
+
+def test_a_lost_scheduler_is_reported_and_finished_tasks_count(recordings, tmp_path):
+    """`dask scheduler` killed (SIGKILL) in the middle of a batch, its worker frozen
+    (SIGSTOP) so that no file changes while the outcome is checked: one line says so,
+    exit 3, no traceback; a task is "ok" exactly when its JSON is written, else "not run"."""
+    sched_file = tmp_path / "scheduler.json"
+    env = env_with_package()
+    procs = []
+    out = tmp_path / "out"
+    try:
+        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
+                                       "--no-dashboard", "--scheduler-file", str(sched_file)],
+                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                      start_new_session=True))
+        deadline = time.time() + 60
+        while not sched_file.exists() and time.time() < deadline:
+            time.sleep(0.05)
+        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
+                                       "--nthreads", "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"],
+                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                      start_new_session=True))
+        driver = subprocess.Popen([sys.executable, "-m", "evcorner", "batch", *recordings, "-d", ",".join(DETECTORS),
+                                   "-p", "harris_window=5,7,9,11,13,15", "-o", str(out),
+                                   "--scheduler-file", str(sched_file)],
+                                  env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                  start_new_session=True)
+        procs.append(driver)
+        log = out / "results.jsonl"
+        deadline = time.time() + 120
+        while time.time() < deadline and driver.poll() is None and not (log.exists() and log.read_text()):
+            time.sleep(0.02)
+        assert driver.poll() is None, "the batch ended before the scheduler could be lost"
+        os.killpg(procs[1].pid, signal.SIGSTOP)
+        os.killpg(procs[0].pid, signal.SIGKILL)
+        stdout, stderr = driver.communicate(timeout=120)
+        assert driver.returncode == 3, stderr
+        assert "Traceback" not in stderr and "CancelledError" not in stdout + stderr, stderr
+        assert "lost the scheduler: " in stderr and "rerun the same command" in stderr, stderr
+        tasks = batch.plan(recordings, DETECTORS, out, params={"harris_window": [5, 7, 9, 11, 13, 15]})
+        final = {}
+        for r in lines(log):
+            final[r["task"]] = r
+        assert set(final) == {t["key"] for t in tasks}
+        finished = 0
+        for t in tasks:
+            has_json = Path(t["summary"]).exists()
+            finished += has_json
+            assert final[t["key"]]["status"] == ("ok" if has_json else batch.NOT_RUN), (t, final[t["key"]])
+            assert has_json == Path(t["corners"]).exists()
+        assert 1 <= finished < len(tasks)
+        assert f"{finished} of {len(tasks)} tasks finished" in stderr
+        assert stdout.count(" ok") == finished and stdout.count("NOT RUN") == len(tasks) - finished
+    finally:
+        if len(procs) > 1:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(procs[1].pid, signal.SIGCONT)
+        for p in procs:
+            stop_group(p, signal.SIGKILL)
+    assert all(p.poll() is not None for p in procs)
