@@ -41,7 +41,7 @@ from ._detectors import detectors as _registry
 # The corner file extensions a batch writes, by --to: an extension, or a format name of
 # OUTPUT_FORMATS (the formats the library writes).
 _EXTENSION_OF = {"txt": "txt", "ecd-text": "txt", "csv": "csv", "npy": "npy", "aedat4": "aedat4",
-                 "h5": "h5", "hdf5": "h5"}
+                 "h5": "h5", "hdf5": "hdf5"}
 
 # What every temporary name of a task holds right after its tag.
 _TMP_MARK = ".evcorner-batch-"
