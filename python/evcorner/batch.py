@@ -11,8 +11,9 @@ where it stopped.
 Outputs are whole or absent: a task writes under hidden temporary names
 (.<tag>.evcorner-batch-<pid>-<hex>...) and renames them onto the corner file and then the
 summary JSON once both are complete; a failed task removes what it wrote. Temporary files
-that a killed worker or an interrupted batch left are removed by clean() (submit() calls
-it for every task it submits, so a resumed batch removes them).
+that a killed worker or an interrupted batch left are removed by clean(): submit() calls
+it for every task it submits (so a resumed batch removes them), gather() for every task
+whose future ended.
 
     from dask.distributed import Client, LocalCluster
     from evcorner import batch
@@ -296,6 +297,11 @@ def gather(tasks, futures, out_dir, progress=None):
             if records[t["key"]].get("status") == NOT_RUN and (r := done(t)) is not None:
                 r["recovered"] = True
                 record(r)
+    # What a worker killed in the middle of a task left (the task ran again elsewhere); not
+    # for tasks that may still be running on a worker the scheduler lost.
+    for t in tasks:
+        if records[t["key"]].get("status") != NOT_RUN:
+            clean(t)
     return [records[t["key"]] for t in tasks]
 
 

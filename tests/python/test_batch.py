@@ -382,3 +382,62 @@ def test_a_lost_scheduler_is_reported_and_finished_tasks_count(recordings, tmp_p
         for p in procs:
             stop_group(p, signal.SIGKILL)
     assert all(p.poll() is not None for p in procs)
+
+
+def test_a_killed_worker_leaves_no_temporary_file(recordings, tmp_path):
+    """A worker killed (SIGKILL) while it writes a corner file: its task runs again on the
+    other worker, the batch ends with every task ok and no temporary file left."""
+    big = tmp_path / "big.npy"
+    events = evcorner.read(SAMPLE)
+    span = int(events["t"][-1] - events["t"][0]) + 1000
+    copies = []
+    for i in range(40):  # 1.2 M events: a task lasts long enough to be caught writing
+        e = events.copy()
+        e["t"] += i * span
+        copies.append(e)
+    evcorner.write(big, np.concatenate(copies))
+    sched_file = tmp_path / "scheduler.json"
+    env = env_with_package()
+    out = tmp_path / "out"
+    procs = []
+    try:
+        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
+                                       "--no-dashboard", "--scheduler-file", str(sched_file)],
+                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                      start_new_session=True))
+        deadline = time.time() + 60
+        while not sched_file.exists() and time.time() < deadline:
+            time.sleep(0.05)
+        for _ in range(2):
+            procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
+                                           "--nthreads", "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"],
+                                          env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                          start_new_session=True))
+        from dask.distributed import Client
+        with Client(scheduler_file=str(sched_file), timeout=60) as c:
+            c.wait_for_workers(2, timeout=60)
+        driver = subprocess.Popen([sys.executable, "-m", "evcorner", "batch", str(big), "-d", "harris",
+                                   "-p", "harris_window=11,13,15", "-o", str(out), "--scheduler-file", str(sched_file)],
+                                  env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                  start_new_session=True)
+        procs.append(driver)
+        # Kill the worker that writes the first temporary corner file seen.
+        victim = None
+        deadline = time.time() + 120
+        while victim is None and time.time() < deadline and driver.poll() is None:
+            for p in out.rglob(".*evcorner-batch-*"):
+                pid = int(p.name.split("evcorner-batch-")[1].split("-")[0])
+                if pid in {w.pid for w in procs[1:3]}:
+                    victim = next(w for w in procs[1:3] if w.pid == pid)
+                    os.killpg(victim.pid, signal.SIGKILL)
+                    break
+            time.sleep(0.005)
+        if victim is None:
+            pytest.skip("no temporary file was seen before the batch ended (too fast here)")
+        stdout, stderr = driver.communicate(timeout=300)
+        assert driver.returncode == 0, stderr
+        assert stdout.count(" ok") == 3, stdout
+        assert not list(out.rglob(".*")), "temporary files left"
+    finally:
+        for p in procs:
+            stop_group(p, signal.SIGKILL)
