@@ -324,6 +324,24 @@ def test_external_scheduler_and_two_dask_workers(recordings, cli_counts, tmp_pat
     assert all(p.poll() is not None for p in procs)
 
 
+def start_scheduler(sched_file, env):
+    """`dask scheduler` on 127.0.0.1 in a process group of its own, once its file is there."""
+    proc = subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
+                             "--no-dashboard", "--scheduler-file", str(sched_file)],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + 60
+    while not sched_file.exists() and time.time() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    return proc
+
+
+def start_worker(sched_file, env):
+    """A single-threaded `dask worker` on 127.0.0.1 without a nanny (the task runs in it)."""
+    return subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
+                             "--nthreads", "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+
+
 def test_a_lost_scheduler_is_reported_and_finished_tasks_count(recordings, tmp_path):
     """`dask scheduler` killed (SIGKILL) in the middle of a batch, its worker frozen
     (SIGSTOP) so that no file changes while the outcome is checked: one line says so,
@@ -333,17 +351,8 @@ def test_a_lost_scheduler_is_reported_and_finished_tasks_count(recordings, tmp_p
     procs = []
     out = tmp_path / "out"
     try:
-        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
-                                       "--no-dashboard", "--scheduler-file", str(sched_file)],
-                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                      start_new_session=True))
-        deadline = time.time() + 60
-        while not sched_file.exists() and time.time() < deadline:
-            time.sleep(0.05)
-        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
-                                       "--nthreads", "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"],
-                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                      start_new_session=True))
+        procs.append(start_scheduler(sched_file, env))
+        procs.append(start_worker(sched_file, env))
         driver = subprocess.Popen([sys.executable, "-m", "evcorner", "batch", *recordings, "-d", ",".join(DETECTORS),
                                    "-p", "harris_window=5,7,9,11,13,15", "-o", str(out),
                                    "--scheduler-file", str(sched_file)],
@@ -401,18 +410,9 @@ def test_a_killed_worker_leaves_no_temporary_file(recordings, tmp_path):
     out = tmp_path / "out"
     procs = []
     try:
-        procs.append(subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
-                                       "--no-dashboard", "--scheduler-file", str(sched_file)],
-                                      env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                      start_new_session=True))
-        deadline = time.time() + 60
-        while not sched_file.exists() and time.time() < deadline:
-            time.sleep(0.05)
+        procs.append(start_scheduler(sched_file, env))
         for _ in range(2):
-            procs.append(subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
-                                           "--nthreads", "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"],
-                                          env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                          start_new_session=True))
+            procs.append(start_worker(sched_file, env))
         from dask.distributed import Client
         with Client(scheduler_file=str(sched_file), timeout=60) as c:
             c.wait_for_workers(2, timeout=60)
