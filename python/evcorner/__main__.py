@@ -13,6 +13,7 @@ resumes a batch (finished tasks are skipped).
 import argparse
 import logging
 import os
+import signal
 import sys
 import time
 
@@ -42,8 +43,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m evcorner", description=__doc__.split("\n\n")[1],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
-    b = sub.add_parser("batch", help="detectors over many recordings on Dask distributed")
-    b.add_argument("inputs", nargs="+", help="event files (any format evcorner reads)")
+    b = sub.add_parser("batch", help="detectors over many recordings on Dask distributed",
+                       description=__doc__.split("\n\n")[1], formatter_class=argparse.RawDescriptionHelpFormatter)
+    b.add_argument("inputs", nargs="+", help="event files (any format evcorner reads) or rosbag2 folders")
     b.add_argument("-d", "--detectors", default="efast", help="comma-separated registry names (default efast)")
     b.add_argument("-p", "--param", action="append", type=_param, default=[], metavar="KEY=V[,V...]",
                    help="a detector parameter (harris_window=5,7: one task per value); each detector takes "
@@ -53,7 +55,7 @@ def main(argv=None):
                                                "(or ecd-text, hdf5)")
     where = b.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a running scheduler, tcp://HOST:PORT")
-    where.add_argument("--scheduler-file", help="scheduler file written by `dask scheduler --scheduler-file`")
+    where.add_argument("--scheduler-file", help="scheduler file written by `python -m dask scheduler --scheduler-file FILE`")
     b.add_argument("--workers", type=int, default=os.cpu_count(),
                    help="LocalCluster worker processes (default: one per core, %(default)s here)")
     b.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
@@ -102,9 +104,15 @@ def _run(args, tasks, batch):
             elif args.scheduler_file:
                 client = Client(scheduler_file=args.scheduler_file, timeout=30)
             else:
-                cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=":0", silence_logs=logging.INFO if args.verbose
-                                       else logging.CRITICAL)
+                # The worker processes ignore SIGINT (they inherit that): Ctrl-C reaches the
+                # whole process group, and it is this process that stops them, in order.
+                previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+                try:
+                    cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                                           dashboard_address=":0", silence_logs=logging.INFO if args.verbose
+                                           else logging.CRITICAL)
+                finally:
+                    signal.signal(signal.SIGINT, previous)
                 client = Client(cluster)
         except OSError as e:
             _say(f"cannot reach the scheduler {args.scheduler or args.scheduler_file}: {e}")

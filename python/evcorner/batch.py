@@ -11,8 +11,9 @@ where it stopped.
 Outputs are whole or absent: a task writes under hidden temporary names
 (.<tag>.evcorner-batch-<pid>-<hex>...) and renames them onto the corner file and then the
 summary JSON once both are complete; a failed task removes what it wrote. Temporary files
-that a killed worker or an interrupted batch left are removed by clean() (submit() calls
-it for every task it submits, so a resumed batch removes them).
+that a killed worker or an interrupted batch left are removed by clean(): submit() calls
+it for every task it submits (so a resumed batch removes them), gather() for every task
+whose future ended.
 
     from dask.distributed import Client, LocalCluster
     from evcorner import batch
@@ -41,7 +42,7 @@ from ._detectors import detectors as _registry
 # The corner file extensions a batch writes, by --to: an extension, or a format name of
 # OUTPUT_FORMATS (the formats the library writes).
 _EXTENSION_OF = {"txt": "txt", "ecd-text": "txt", "csv": "csv", "npy": "npy", "aedat4": "aedat4",
-                 "h5": "h5", "hdf5": "h5"}
+                 "h5": "h5", "hdf5": "hdf5"}
 
 # What every temporary name of a task holds right after its tag.
 _TMP_MARK = ".evcorner-batch-"
@@ -296,6 +297,11 @@ def gather(tasks, futures, out_dir, progress=None):
             if records[t["key"]].get("status") == NOT_RUN and (r := done(t)) is not None:
                 r["recovered"] = True
                 record(r)
+    # What a worker killed in the middle of a task left (the task ran again elsewhere); not
+    # for tasks that may still be running on a worker the scheduler lost.
+    for t in tasks:
+        if records[t["key"]].get("status") != NOT_RUN:
+            clean(t)
     return [records[t["key"]] for t in tasks]
 
 

@@ -3,6 +3,7 @@
 files, and resuming an interrupted batch. Every process a test starts is on 127.0.0.1 and
 stopped at its end (its process group killed), failed or not."""
 
+import contextlib
 import json
 import os
 import signal
@@ -221,31 +222,38 @@ def test_resume_skips_what_was_done(client, recordings, cli_counts, tmp_path):
 
 
 def test_cli_interrupted_then_resumed(recordings, cli_counts, tmp_path):
-    """Interrupts `python3 -m evcorner batch` (SIGINT) once a result is logged, then reruns it."""
+    """Interrupts `python3 -m evcorner batch` (SIGINT to its process group, as Ctrl-C does)
+    once a result is logged: it stops at once, says so in one line (exit 130), leaves no
+    temporary file and no corner file without its JSON; then reruns it to completion."""
     out = tmp_path / "out"
-    inputs = recordings * 1
-    cmd = [sys.executable, "-m", "evcorner", "batch", *inputs, "-d", ",".join(DETECTORS), "-o", str(out),
-           "--workers", "1", "-p", "harris_window=5,7,9"]
+    windows = [5, 7, 9, 11, 13, 15]
+    cmd = [sys.executable, "-m", "evcorner", "batch", *recordings, "-d", ",".join(DETECTORS), "-o", str(out),
+           "--workers", "1", "-p", "harris_window=" + ",".join(map(str, windows))]
     proc = subprocess.Popen(cmd, env=env_with_package(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            start_new_session=True)
+                            start_new_session=True, text=True)
     log = out / "results.jsonl"
-    deadline = time.time() + 60
-    while time.time() < deadline and proc.poll() is None:
-        if log.exists() and log.read_text().count("\n") >= 1:
-            break
-        time.sleep(0.02)
-    if proc.poll() is None:
-        os.killpg(proc.pid, signal.SIGINT)
     try:
-        proc.communicate(timeout=60)
+        deadline = time.time() + 60
+        while time.time() < deadline and proc.poll() is None:
+            if log.exists() and log.read_text().count("\n") >= 1:
+                break
+            time.sleep(0.02)
+        assert proc.poll() is None, "the batch ended before it could be interrupted"
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
     finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
-    total = len(recordings) * (1 + 3)
-    done_before = len(list(out.rglob("*.json")))
-    assert 1 <= done_before <= total
-    rerun = subprocess.run(cmd, env=env_with_package(), capture_output=True, text=True, timeout=120)
+        stop_group(proc)
+    total = len(recordings) * (1 + len(windows))
+    assert proc.returncode == 130, err
+    assert "interrupted: " in err and "rerun the same command to resume" in err, err
+    assert "Traceback" not in err, err
+    assert not [p for p in out.rglob(".*")], "temporary files left"
+    corners = {p.with_suffix("") for p in out.rglob("*.txt")}
+    summaries = {p.with_suffix("") for p in out.rglob("*.json")}
+    assert corners == summaries
+    done_before = len(summaries)
+    assert 1 <= done_before < total
+    rerun = subprocess.run(cmd, env=env_with_package(), capture_output=True, text=True, timeout=300)
     assert rerun.returncode == 0, rerun.stderr
     assert f"({done_before} done before)" in rerun.stderr
     assert rerun.stdout.count("ok (resumed)") == done_before
@@ -253,6 +261,20 @@ def test_cli_interrupted_then_resumed(recordings, cli_counts, tmp_path):
         if r["detector"] == "efast":
             assert r["corners"] == cli_counts[(r["input"], "efast")]
     assert len({r["task"] for r in lines(log)}) == total
+
+
+def stop_group(proc, sig=signal.SIGTERM):
+    """Stops `proc` and everything in its process group (started with start_new_session)."""
+    for s in (sig, signal.SIGKILL):
+        if proc.poll() is not None:
+            break
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, s)
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            proc.wait(timeout=20)
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(proc.pid, signal.SIGKILL)  # what the leader left behind in its group
+    proc.wait()
 
 
 def test_external_scheduler_and_two_dask_workers(recordings, cli_counts, tmp_path):
@@ -300,3 +322,122 @@ def test_external_scheduler_and_two_dask_workers(recordings, cli_counts, tmp_pat
                 p.kill()
                 p.wait()
     assert all(p.poll() is not None for p in procs)
+
+
+def start_scheduler(sched_file, env):
+    """`dask scheduler` on 127.0.0.1 in a process group of its own, once its file is there."""
+    proc = subprocess.Popen([sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
+                             "--no-dashboard", "--scheduler-file", str(sched_file)],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + 60
+    while not sched_file.exists() and time.time() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    return proc
+
+
+def start_worker(sched_file, env):
+    """A single-threaded `dask worker` on 127.0.0.1 without a nanny (the task runs in it)."""
+    return subprocess.Popen([sys.executable, "-m", "dask", "worker", "--scheduler-file", str(sched_file),
+                             "--nthreads", "1", "--no-nanny", "--no-dashboard", "--host", "127.0.0.1"],
+                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+
+
+def test_a_lost_scheduler_is_reported_and_finished_tasks_count(recordings, tmp_path):
+    """`dask scheduler` killed (SIGKILL) in the middle of a batch, its worker frozen
+    (SIGSTOP) so that no file changes while the outcome is checked: one line says so,
+    exit 3, no traceback; a task is "ok" exactly when its JSON is written, else "not run"."""
+    sched_file = tmp_path / "scheduler.json"
+    env = env_with_package()
+    procs = []
+    out = tmp_path / "out"
+    try:
+        procs.append(start_scheduler(sched_file, env))
+        procs.append(start_worker(sched_file, env))
+        driver = subprocess.Popen([sys.executable, "-m", "evcorner", "batch", *recordings, "-d", ",".join(DETECTORS),
+                                   "-p", "harris_window=5,7,9,11,13,15", "-o", str(out),
+                                   "--scheduler-file", str(sched_file)],
+                                  env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                  start_new_session=True)
+        procs.append(driver)
+        log = out / "results.jsonl"
+        deadline = time.time() + 120
+        while time.time() < deadline and driver.poll() is None and not (log.exists() and log.read_text()):
+            time.sleep(0.02)
+        assert driver.poll() is None, "the batch ended before the scheduler could be lost"
+        os.killpg(procs[1].pid, signal.SIGSTOP)
+        os.killpg(procs[0].pid, signal.SIGKILL)
+        stdout, stderr = driver.communicate(timeout=120)
+        assert driver.returncode == 3, stderr
+        assert "Traceback" not in stderr and "CancelledError" not in stdout + stderr, stderr
+        assert "lost the scheduler: " in stderr and "rerun the same command" in stderr, stderr
+        tasks = batch.plan(recordings, DETECTORS, out, params={"harris_window": [5, 7, 9, 11, 13, 15]})
+        final = {}
+        for r in lines(log):
+            final[r["task"]] = r
+        assert set(final) == {t["key"] for t in tasks}
+        finished = 0
+        for t in tasks:
+            has_json = Path(t["summary"]).exists()
+            finished += has_json
+            assert final[t["key"]]["status"] == ("ok" if has_json else batch.NOT_RUN), (t, final[t["key"]])
+            assert has_json == Path(t["corners"]).exists()
+        assert 1 <= finished < len(tasks)
+        assert f"{finished} of {len(tasks)} tasks finished" in stderr
+        assert stdout.count(" ok") == finished and stdout.count("NOT RUN") == len(tasks) - finished
+    finally:
+        if len(procs) > 1:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(procs[1].pid, signal.SIGCONT)
+        for p in procs:
+            stop_group(p, signal.SIGKILL)
+    assert all(p.poll() is not None for p in procs)
+
+
+def test_a_killed_worker_leaves_no_temporary_file(recordings, tmp_path):
+    """A worker killed (SIGKILL) while it writes a corner file: its task runs again on the
+    other worker, the batch ends with every task ok and no temporary file left."""
+    big = tmp_path / "big.npy"
+    events = evcorner.read(SAMPLE)
+    span = int(events["t"][-1] - events["t"][0]) + 1000
+    copies = []
+    for i in range(40):  # 1.2 M events: a task lasts long enough to be caught writing
+        e = events.copy()
+        e["t"] += i * span
+        copies.append(e)
+    evcorner.write(big, np.concatenate(copies))
+    sched_file = tmp_path / "scheduler.json"
+    env = env_with_package()
+    out = tmp_path / "out"
+    procs = []
+    try:
+        procs.append(start_scheduler(sched_file, env))
+        for _ in range(2):
+            procs.append(start_worker(sched_file, env))
+        from dask.distributed import Client
+        with Client(scheduler_file=str(sched_file), timeout=60) as c:
+            c.wait_for_workers(2, timeout=60)
+        driver = subprocess.Popen([sys.executable, "-m", "evcorner", "batch", str(big), "-d", "harris",
+                                   "-p", "harris_window=11,13,15", "-o", str(out), "--scheduler-file", str(sched_file)],
+                                  env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                  start_new_session=True)
+        procs.append(driver)
+        # Kill the worker that writes the first temporary corner file seen.
+        victim = None
+        deadline = time.time() + 120
+        while victim is None and time.time() < deadline and driver.poll() is None:
+            for p in out.rglob(".*evcorner-batch-*"):
+                pid = int(p.name.split("evcorner-batch-")[1].split("-")[0])
+                if pid in {w.pid for w in procs[1:3]}:
+                    victim = next(w for w in procs[1:3] if w.pid == pid)
+                    os.killpg(victim.pid, signal.SIGKILL)
+                    break
+            time.sleep(0.005)
+        if victim is None:
+            pytest.skip("no temporary file was seen before the batch ended (too fast here)")
+        stdout, stderr = driver.communicate(timeout=300)
+        assert driver.returncode == 0, stderr
+        assert stdout.count(" ok") == 3, stdout
+        assert not list(out.rglob(".*")), "temporary files left"
+    finally:
+        for p in procs:
+            stop_group(p, signal.SIGKILL)
