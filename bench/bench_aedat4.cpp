@@ -1,4 +1,4 @@
-// AEDAT 4.0 reader throughput (events/s), issue 5 target >= 100 M events/s: the real
+// AEDAT 4.0 reader throughput (events/s), target >= 100 M events/s: the real
 // DVXplorer recording (LZ4, 59 event packets among IMU packets) and a synthetic 4 M-event
 // file written by Aedat4Writer (LZ4 and uncompressed, 8192-event packets, random pixels
 // with slowly rising time, so LZ4 finds little to compress in x/y). Page cache, 64 Ki batches.

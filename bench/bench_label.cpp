@@ -1,4 +1,4 @@
-// Feature-track labelling speed (issue 4 target: 100 000 corner events under 10 s on
+// Feature-track labelling speed (target: 100 000 corner events under 10 s on
 // one core). Two inputs of >= 100 000 corner events:
 //  - synthetic: 100 straight tracks (60 events each, 1 px jitter) per 100 ms window plus
 //    25 % uniform clutter, repeated along time;

@@ -1,5 +1,5 @@
 // Reader throughput (events/s) on the real recordings, read from the page cache in
-// 64 Ki-event batches. Issue 5 targets: ECD text >= 20 M events/s, EVT 3.0 >= 100 M.
+// 64 Ki-event batches. Targets: ECD text >= 20 M events/s, EVT 3.0 >= 100 M.
 
 #include <benchmark/benchmark.h>
 

@@ -1,4 +1,4 @@
-// What a cold start costs, measured without replaying a file (issue 14 item 3).
+// What a cold start costs, measured without replaying a file.
 //
 // `evcorner bench` compares a detector's cold pass over a file with the same file replayed
 // to millions of events as identical copies. On a 30 000-event file that replay repeats one

@@ -92,7 +92,7 @@ using Finder = std::size_t (*)(std::span<const Event>, const EventLimits&, TimeS
 // the greatest 16-bit words (x and y) and the OR of the bytes (p <= 1 iff no bit of p
 // above the lowest is set). The padding bytes take part in none of the decisions. What
 // GCC's vectoriser makes of all_accepted() takes about 8.5 instructions per event; this
-// takes about 1.3 (issue 14: the check runs before every checked detect()).
+// takes about 1.3, which matters because the check runs before every checked detect().
 EVCORNER_AVX512_WARNINGS_OFF
 [[gnu::target(EVCORNER_AVX512_TARGET)]] bool all_accepted_avx512(const Event* ev, std::size_t n,
                                                                  const EventLimits& l, TimeSpan* span) noexcept {

@@ -254,7 +254,7 @@ TEST(Aedat2Crafted, HeaderProblems) {
     Aedat2Reader r(p, o);
     EXPECT_EQ(read_all(r).events.size(), 1u);
     // Header only, no records: the format has no end-of-header mark, so this is a file
-    // cut short at the end of a header line (issue 15, item 11), not an empty stream.
+    // cut short at the end of a header line, not an empty stream.
     try {
         Aedat2Reader empty(tmp.write("e.aedat", kDavisHeader));
         ADD_FAILURE() << "a header without records must be an error";
@@ -266,7 +266,7 @@ TEST(Aedat2Crafted, HeaderProblems) {
 }
 
 
-// ---- a "# AEChip" line that does not name the camera (issue 15, item 7)
+// ---- a "# AEChip" line that does not name the camera
 
 // `bytes` with its "# AEChip: ..." line replaced by "# AEChip: `chip`".
 std::string with_chip_line(std::string bytes, const std::string& chip) {

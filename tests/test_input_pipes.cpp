@@ -1,7 +1,7 @@
 // Inputs that can be read only once, front to back: named pipes (FIFOs), the /dev/fd/N
 // paths of process substitution `<(...)`, standard input. The format is told from bytes
-// the reader then reads itself, so nothing is reopened (issue 15, item 12). And headers cut
-// short are errors that name the byte offset, never an empty stream (item 11).
+// the reader then reads itself, so nothing is reopened. And headers cut short are errors
+// that name the byte offset, never an empty stream.
 
 #include <gtest/gtest.h>
 
@@ -266,7 +266,7 @@ TEST(PipeInput, Hdf5FromAFifoIsAClearError) {
     }
 }
 
-// ---- headers cut short (issue 15, item 11)
+// ---- headers cut short
 
 struct Cuttable {
     std::string name;

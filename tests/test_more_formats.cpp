@@ -1,4 +1,4 @@
-// Issue 16 formats: ATIS .bin (N-MNIST, N-Caltech101), MATLAB .mat, gzip / zstd / bzip2 /
+// ATIS .bin (N-MNIST, N-Caltech101), MATLAB .mat, gzip / zstd / bzip2 /
 // xz compressed text and CSV, UTF-8 BOMs, .npy with fields found by name and plain (N, 4)
 // arrays, and the "unsupported format" messages of the detection. The real recordings'
 // figures come from the data READMEs; the rest are crafted files.

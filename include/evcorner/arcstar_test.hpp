@@ -448,8 +448,7 @@ struct ArcStarAvx512 {
     // stride is made opaque to the optimiser at every test (row_stride()): else GCC hoists
     // dy * width + dx for each of the 36 pixels out of the batch loop as an invariant of
     // its own and keeps most of them on the stack, so that every pixel cost a reload of its
-    // offset before its load (main's loop before wt-arc7: 14 of the radius-3 block's 129
-    // instructions).
+    // offset before its load (14 of the radius-3 block's 129 instructions).
     [[gnu::always_inline]] static inline std::ptrdiff_t row_stride(std::ptrdiff_t w) noexcept {
         std::ptrdiff_t stride = w * static_cast<std::ptrdiff_t>(sizeof(std::int64_t));
         __asm__ volatile("" : "+r"(stride));

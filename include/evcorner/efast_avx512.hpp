@@ -105,7 +105,7 @@ template <const auto& Circle, int K, int R>
     return {{join(q0, q4), join(q8, q12), join(q16, q0), join(q4, q8)}};
 }
 
-// The radius-3 test on 32-bit times (issue 14 item 1, wt-efast6). The order of the 16
+// The radius-3 test on 32-bit times. The order of the 16
 // times is all the arc test reads, so they are narrowed at load time: u = q - lo with
 // lo = st - 2^30 (st the event's stored time, q a cell), exact for every fired cell with
 // u in [0, 2^31), that is, time within [-2^30, 2^30) us (about +-17.9 minutes) of the
@@ -222,7 +222,7 @@ inline constexpr std::int64_t kNarrowSpan = std::int64_t{1} << 30;
 // detect_avx512's `flatten` inlines it there. (Tried before the 32-bit test: the radius-4
 // test out of line, as a call, and the stride made opaque once more by an `asm volatile`
 // before it: both made the loop about 1.5x slower. The plain `asm` on copies below, inside
-// the branch, makes it faster: wt-efast7, docs/performance.md.)
+// the branch, makes it faster: docs/performance.md.)
 template <bool InRange>
 [[gnu::target(EVCORNER_AVX512_TARGET)]] inline bool corner(const std::int64_t* centre, std::ptrdiff_t stride,
                                                            std::int64_t st) noexcept {

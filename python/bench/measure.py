@@ -1,4 +1,4 @@
-"""The measurements of docs/python.md (issue 13 item 6). Not a test: speed is measured here.
+"""The measurements of docs/python.md. Not a test: speed is measured here.
 
     PYTHONPATH=build/python /usr/bin/python3 python/bench/measure.py build/bin/evcorner ../shared/data/real/ecd-stppp/*/events.txt
 
