@@ -1,5 +1,6 @@
-// Reader throughput (events/s), one core, from the page cache in 64 Ki-event batches: ATIS .bin, .npy (the evcorner layout's copying path, a structured
-// array with other widths and field order, a plain (N, 4) float array), MATLAB .mat
+// Reader throughput (events/s), one core, from the page cache in 64 Ki-event batches:
+// ATIS .bin, .npy (the evcorner layout's copying path, a structured array with other
+// widths and field order, a plain (N, 4) float array), MATLAB .mat
 // (the real rpg_event_lifetime file and a large synthetic one), and ECD text compressed
 // with gzip, zstd, bzip2 and xz against the plain text. Synthetic files are written once
 // to a temporary folder (4 M events; text 1 M lines) before the first benchmark.
