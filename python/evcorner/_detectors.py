@@ -18,6 +18,52 @@ def detectors():
     return _evcorner.detectors()
 
 
+def _detector_repr(self):
+    """The call that builds this detector: its class, sensor and the parameters given (in the
+    registry's order)."""
+    cls = type(self)
+    order = [p["name"] for d in _evcorner.detectors() if d["name"] == self.name for p in d["params"]]
+    given = self.params
+    params = {k: given[k] for k in sorted(given, key=lambda k: order.index(k) if k in order else len(order))}
+    if getattr(cls, "registry_name", None) == self.name:
+        text = "".join(f", {k}={v!r}" for k, v in params.items())
+        return f"{cls.__name__}({self.sensor[0]}, {self.sensor[1]}{text})"
+    return f"{cls.__name__}({self.name!r}, {self.sensor[0]}, {self.sensor[1]}, {params!r})"
+
+
+def _detector_copy(self):
+    new = type(self).__new__(type(self))
+    Detector.__init__(new, self)
+    return new
+
+
+def _detector_deepcopy(self, memo):
+    new = _detector_copy(self)
+    memo[id(self)] = new
+    return new
+
+
+def _detector_reduce(self):
+    if self.events:
+        raise TypeError(f"cannot pickle {self!r} after it has processed events ({self.events}): the state of a C++ "
+                        f"detector has no serialised form; copy.deepcopy() copies it within a process, and a "
+                        f"detector that has processed nothing (or after reset()) pickles")
+    return (_rebuild, (type(self), self.name, self.sensor, self.params))
+
+
+def _rebuild(cls, name, sensor, params):
+    if getattr(cls, "registry_name", None) == name:
+        return cls(*sensor, **params)
+    return cls(name, *sensor, params)
+
+
+# Copies carry the state (the C++ copy constructor); pickles carry the configuration.
+Detector.__repr__ = _detector_repr
+Detector.__copy__ = _detector_copy
+Detector.__deepcopy__ = _detector_deepcopy
+Detector.__reduce__ = _detector_reduce
+
+
 def _make_class(info):
     name = info["name"]
     lines = [
