@@ -562,7 +562,10 @@ py::list detector_list() {
 }
 
 py::tuple label_py(py::handle corners, const eval::FeatureTrackParams& params) {
-    const std::span<const Event> ev = events_view(corners, "corners");
+    // A private copy (corners are few): another thread writing to the array while the GIL
+    // is released cannot change what the labelling indexes by.
+    const std::span<const Event> view = events_view(corners, "corners");
+    const std::vector<Event> ev(view.begin(), view.end());
     eval::FeatureTrackResult r;
     {
         py::gil_scoped_release release;
@@ -598,7 +601,8 @@ py::tuple simulate_py(const std::string& scene, bool is_path) {
 py::dict evaluate_truth_py(py::handle corners, const std::string& truth, double radius, std::int64_t tolerance_us,
                            const std::string& credit, const std::string& interpolation,
                            std::optional<std::vector<double>> speed_bins) {
-    const std::span<const Event> ev = events_view(corners, "corners");
+    const std::span<const Event> view = events_view(corners, "corners");
+    const std::vector<Event> ev(view.begin(), view.end());  // private, as in label_py
     eval::TruthMatchParams p;
     p.radius = radius;
     p.tolerance_us = tolerance_us;
