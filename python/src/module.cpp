@@ -153,47 +153,6 @@ ParamValues params_from(const py::dict& kw) {
     return values;
 }
 
-/// A registry message with keys spelt as Python keywords ("harris-window" -> "harris_window").
-std::string pythonic(std::string message) {
-    std::vector<std::string_view> keys;
-    for (const DetectorInfo& info : detector_infos())
-        for (const ParamInfo& p : info.params) keys.push_back(p.key);
-    std::sort(keys.begin(), keys.end(), [](auto a, auto b) { return a.size() > b.size(); });
-    for (const std::string_view key : keys) {
-        const std::string id = [&] {
-            std::string s(key);
-            std::replace(s.begin(), s.end(), '-', '_');
-            return s;
-        }();
-        for (std::size_t at = message.find(key); at != std::string::npos; at = message.find(key, at + id.size()))
-            message.replace(at, key.size(), id);
-    }
-    return message;
-}
-
-template <class F>
-decltype(auto) pythonic_errors(F&& f) {
-    try {
-        return f();
-    } catch (const InvalidEvent&) {
-        throw;
-    } catch (const std::invalid_argument& e) {
-        throw py::value_error(pythonic(e.what()));
-    }
-}
-
-/// The C++ class name of D ("EFast"), from the compiler: the Python class takes it.
-template <class T>
-std::string cpp_class_name() {
-    const std::string_view f = __PRETTY_FUNCTION__;  // "... [with T = evcorner::EFast; ...]" (GCC) / "[T = ...]"
-    const auto b = f.find("T = ");
-    if (b == std::string_view::npos) return {};
-    std::string_view s = f.substr(b + 4);
-    s = s.substr(0, s.find_first_of(";]"));
-    if (const auto c = s.rfind("::"); c != std::string_view::npos) s = s.substr(c + 2);
-    return std::string(s);
-}
-
 /// (width, height), or None.
 py::object size_or_none(const std::optional<SensorSize>& s) {
     if (!s) return py::none();
@@ -261,7 +220,7 @@ public:
     PyDetector(std::string name, int width, int height, const py::dict& params)
         : config_{std::move(name), params_from(params)},
           size_(sensor_of(width, height)),
-          det_(pythonic_errors([&] { return make_detector(config_, size_); })) {}
+          det_(make_detector(config_, size_, kIdentifierKeys)) {}
 
     /// A copy of `o` with its state: it goes on from where `o` is.
     PyDetector(const PyDetector& o) : PyDetector(o, std::lock_guard(o.mutex_)) {}
@@ -311,7 +270,7 @@ public:
 
     void reset() {
         const std::lock_guard lock(mutex_);
-        det_ = make_detector(config_, size_);
+        det_ = make_detector(config_, size_, kIdentifierKeys);
         events_ = corners_ = 0;
         last_address_ = 0;
         last_t_.reset();
@@ -518,26 +477,22 @@ py::dict detect_file_py(const std::string& input, const std::string& output, con
     options.with_score = with_score;
     options.threads = threads;
     options.allow_damaged = allow_damaged;
-    const pipeline::DetectSummary s = pythonic_errors([&] {
-        pipeline::check_detect_options(options);
+    options.param_prefix = kIdentifierKeys;  // messages name with_score=, harris_window=
+    pipeline::check_detect_options(options);
+    pipeline::DetectSummary s;
+    {
         py::gil_scoped_release release;
-        return pipeline::detect_file(files, options);
-    });
+        s = pipeline::detect_file(files, options);
+    }
     return summary_dict(s, input, params);
 }
 
 py::list detector_list() {
-    std::vector<std::pair<std::string, std::string>> classes;
-    for_each_detector_entry([&](const auto& e) {
-        using D = typename std::remove_cvref_t<decltype(e)>::Detector;
-        classes.emplace_back(std::string(e.name), cpp_class_name<D>());
-    });
     py::list out;
     for (const DetectorInfo& info : detector_infos()) {
         py::dict d;
         d["name"] = std::string(info.name);
-        for (const auto& [n, c] : classes)
-            if (n == info.name) d["class_name"] = c;
+        d["class_name"] = std::string(info.class_name);
         d["summary"] = std::string(info.summary);
         d["has_score"] = info.has_score;
         d["local"] = info.local();
@@ -606,12 +561,10 @@ py::dict evaluate_truth_py(py::handle corners, const std::string& truth, double 
     eval::TruthMatchParams p;
     p.radius = radius;
     p.tolerance_us = tolerance_us;
-    pythonic_errors([&] {
-        p.credit = eval::parse_credit(credit);
-        p.interpolation = eval::parse_interpolation(interpolation);
-        if (speed_bins) p.speed_edges = std::move(*speed_bins);
-        eval::validate(p);
-    });
+    p.credit = eval::parse_credit(credit);
+    p.interpolation = eval::parse_interpolation(interpolation);
+    if (speed_bins) p.speed_edges = std::move(*speed_bins);
+    eval::validate(p);
     eval::TruthMatchResult r;
     eval::ErrorSummary err;
     {
@@ -771,26 +724,15 @@ PYBIND11_MODULE(_evcorner, m) {
         .def_property(
             "overlap", [](const eval::FeatureTrackParams& p) { return std::string(eval::to_string(p.overlap)); },
             [](eval::FeatureTrackParams& p, const std::string& s) {
-                pythonic_errors([&] { p.overlap = eval::parse_track_overlap(s); });
+                p.overlap = eval::parse_track_overlap(s);
             })
         .def_readwrite("cell_size", &eval::FeatureTrackParams::cell_size);
-    m.def("label", [](py::handle corners, const eval::FeatureTrackParams& p) {
-        return pythonic_errors([&] { return label_py(corners, p); });
-    });
+    m.def("label", &label_py);
     m.def("reduction_rate", &eval::reduction_rate, py::arg("n_events"), py::arg("n_corners"),
           "The reduction rate in percent from two counts: 100 (1 - n_corners / n_events); 0 for no events.");
     m.def("ft_percent", &eval::ft_percent, py::arg("n_corners"), py::arg("n_on_track"),
           "The feature-track percentage from two counts: 100 n_on_track / n_corners; 0 for no corners.");
     m.def("simulate", &simulate_py, py::arg("scene"), py::arg("is_path"));
-    m.def(
-        "evaluate_truth",
-        [](py::handle corners, const std::string& truth, double radius, std::int64_t tolerance_us,
-           const std::string& credit, const std::string& interpolation, std::optional<std::vector<double>> speed_bins) {
-            return pythonic_errors([&] {
-                return evaluate_truth_py(corners, truth, radius, tolerance_us, credit, interpolation,
-                                         std::move(speed_bins));
-            });
-        },
-        py::arg("corners"), py::arg("truth"), py::arg("radius"), py::arg("tolerance_us"), py::arg("credit"),
-        py::arg("interpolation"), py::arg("speed_bins") = py::none());
+    m.def("evaluate_truth", &evaluate_truth_py, py::arg("corners"), py::arg("truth"), py::arg("radius"),
+          py::arg("tolerance_us"), py::arg("credit"), py::arg("interpolation"), py::arg("speed_bins") = py::none());
 }

@@ -408,3 +408,27 @@ def test_metrics_take_counts_by_their_documented_keywords():
     assert evcorner.reduction_rate(n_events=200, n_corners=50) == 75.0
     assert evcorner.ft_percent(n_corners=40, n_on_track=10) == 25.0
     assert evcorner.reduction_rate(0, 0) == 0.0 and evcorner.ft_percent(0, 0) == 0.0
+
+
+def test_errors_name_python_keywords_not_cli_flags(tmp_path):
+    def message(f):
+        with pytest.raises(ValueError) as e:
+            f()
+        assert "--" not in str(e.value), str(e.value)
+        return str(e.value)
+
+    assert message(lambda: evcorner.Harris(240, 180, harris_window=3)).startswith("harris_window must be within 5..15")
+    assert message(lambda: evcorner.Harris(240, 180, harris_k=float("inf"))).startswith("harris_k must be a finite")
+    m = message(lambda: evcorner.EFast(240, 180, harris_window=7))
+    assert "takes no parameter harris_window (it takes none)" in m
+    m = message(lambda: evcorner.Harris(240, 180, arc_filter=True))
+    assert "takes no parameter arc_filter (it takes: harris_window, harris_nl, harris_k, harris_threshold)" in m
+    local = [d["name"] for d in INFOS if not d["local"]]
+    m = message(lambda: evcorner.detect_file(SAMPLE, threads=2, detector=local[0]))
+    assert m.startswith(f"threads: detector '{local[0]}' is not local")
+    m = message(lambda: evcorner.detect_file(SAMPLE, tmp_path / "c.npy", with_score=True))
+    assert m.startswith("with_score writes 't x y p score' text lines")
+    assert message(lambda: evcorner.detect_file(SAMPLE, threads=2, with_score=True)) == \
+        "threads: with_score needs one thread"
+    assert message(lambda: evcorner.detect_file(SAMPLE, harris_window=4, detector="harris")).startswith(
+        "harris_window must be within")
