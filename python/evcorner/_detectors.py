@@ -79,7 +79,8 @@ def _make_class(info):
     __init__.__doc__ = f"{info['class_name']}(width, height, **params): the '{name}' detector on a width x height sensor."
     doc = (
         f"{info['summary']}\n\n"
-        f"Registry name '{name}'. process(events, out=None) -> uint8 mask; state is kept across calls."
+        f"Registry name '{name}'. process(events, out=None) -> uint8 mask; state is kept across calls, "
+        f"and events must come in time order across them (InvalidEvent otherwise; reset() starts anew)."
         + (" process_scored(events) -> (mask, scores)." if info["has_score"] else "")
         + "\n\nKeyword parameters (default, range): "
         + ("\n    " + "\n    ".join(lines) if lines else "none")
@@ -97,7 +98,8 @@ DETECTOR_CLASSES = {info["class_name"]: _make_class(info) for info in _evcorner.
 def detect(events, detector="efast", sensor=DAVIS240, scores=False, out=None, **params):
     """Runs `detector` (a registry name) over EVENT_DTYPE `events` in one call, read in
     place: returns the uint8 mask (1 = corner), or (mask, scores) with scores=True.
-    `sensor` = (width, height), the DAVIS240C's 240x180 by default as in the CLI."""
+    `sensor` = (width, height), the DAVIS240C's 240x180 by default as in the CLI. Events
+    off the sensor or out of time order raise evcorner.InvalidEvent naming the event."""
     w, h = _size(sensor, "sensor")
     det = Detector(detector, w, h, params)
     if scores:
