@@ -259,10 +259,10 @@ reps = 100
 events = np.concatenate([base] * reps)
 span = int(base["t"][-1] - base["t"][0]) + 1
 events["t"] += np.repeat(np.arange(reps, dtype=np.int64) * span, len(base))
-x, y = events["x"].copy(), events["y"].copy()
+x, y, t = events["x"].copy(), events["y"].copy(), events["t"].copy()
 outcomes = []
 for attempt in range(4):
-    events["x"], events["y"] = x, y
+    events["x"], events["y"], events["t"] = x, y, t
     det = evcorner.detectors()  # (keeps the interpreter busy a moment between attempts)
     def spoil():
         time.sleep(0.03 + 0.02 * attempt)
