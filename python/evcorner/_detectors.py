@@ -1,5 +1,6 @@
 """Detectors (one class per registry entry), one-call detection, evaluation, simulation."""
 
+import inspect
 import os
 
 import numpy as np
@@ -77,6 +78,15 @@ def _make_class(info):
         Detector.__init__(self, name, width, height, params)
 
     __init__.__doc__ = f"{info['class_name']}(width, height, **params): the '{name}' detector on a width x height sensor."
+    # help() and inspect show the registry's keywords with their defaults and types.
+    P = inspect.Parameter
+    types = {"integer": int, "number": float, "true/false": bool}
+    __init__.__signature__ = inspect.Signature(
+        [P("self", P.POSITIONAL_OR_KEYWORD), P("width", P.POSITIONAL_OR_KEYWORD, annotation=int),
+         P("height", P.POSITIONAL_OR_KEYWORD, annotation=int)]
+        + [P(p["name"], P.KEYWORD_ONLY, default=p["default"], annotation=types.get(p["type"], P.empty))
+           for p in info["params"]],
+        return_annotation=None)
     doc = (
         f"{info['summary']}\n\n"
         f"Registry name '{name}'. process(events, out=None) -> uint8 mask; state is kept across calls, "

@@ -432,3 +432,16 @@ def test_errors_name_python_keywords_not_cli_flags(tmp_path):
         "threads: with_score needs one thread"
     assert message(lambda: evcorner.detect_file(SAMPLE, harris_window=4, detector="harris")).startswith(
         "harris_window must be within")
+
+
+def test_classes_show_the_registry_keywords_in_their_signature():
+    import inspect
+    types = {"integer": int, "number": float, "true/false": bool}
+    for info in INFOS:
+        sig = inspect.signature(getattr(evcorner, info["class_name"]))
+        params = list(sig.parameters.values())
+        assert [p.name for p in params[:2]] == ["width", "height"]
+        kw = params[2:]
+        assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in kw)
+        assert [(p.name, p.default, p.annotation) for p in kw] == \
+            [(p["name"], p["default"], types[p["type"]]) for p in info["params"]]
