@@ -47,13 +47,19 @@ std::string param_key(std::string_view identifier) {
     return key;
 }
 
-namespace detail {
-
-void param_error(std::string_view prefix, std::string_view key, const std::string& what) {
-    throw std::invalid_argument(std::string(prefix) + std::string(key) + " " + what);
+std::string KeySpelling::operator()(std::string_view key) const {
+    std::string s(prefix);
+    for (const char c : key) s += identifiers && c == '-' ? '_' : c;
+    return s;
 }
 
-std::int64_t param_as_integer(std::string_view prefix, std::string_view key, const ParamValue& v) {
+namespace detail {
+
+void param_error(const KeySpelling& prefix, std::string_view key, const std::string& what) {
+    throw std::invalid_argument(prefix(key) + " " + what);
+}
+
+std::int64_t param_as_integer(const KeySpelling& prefix, std::string_view key, const ParamValue& v) {
     if (const std::int64_t* i = std::get_if<std::int64_t>(&v)) return *i;
     if (const double* d = std::get_if<double>(&v)) {
         if (std::isfinite(*d) && std::trunc(*d) == *d && std::fabs(*d) < 9.0e18) return static_cast<std::int64_t>(*d);
@@ -62,7 +68,7 @@ std::int64_t param_as_integer(std::string_view prefix, std::string_view key, con
     param_error(prefix, key, "takes an integer (got " + format_param_value(v) + ")");
 }
 
-double param_as_real(std::string_view prefix, std::string_view key, const ParamValue& v) {
+double param_as_real(const KeySpelling& prefix, std::string_view key, const ParamValue& v) {
     double x = 0;
     if (const double* d = std::get_if<double>(&v))
         x = *d;
@@ -74,13 +80,13 @@ double param_as_real(std::string_view prefix, std::string_view key, const ParamV
     return x;
 }
 
-bool param_as_boolean(std::string_view prefix, std::string_view key, const ParamValue& v) {
+bool param_as_boolean(const KeySpelling& prefix, std::string_view key, const ParamValue& v) {
     if (const bool* b = std::get_if<bool>(&v)) return *b;
     if (const std::int64_t* i = std::get_if<std::int64_t>(&v); i && (*i == 0 || *i == 1)) return *i == 1;
     param_error(prefix, key, "takes true or false (got " + format_param_value(v) + ")");
 }
 
-void check_param_range(std::string_view prefix, std::string_view key, double v, double min, double max) {
+void check_param_range(const KeySpelling& prefix, std::string_view key, double v, double min, double max) {
     if (v >= min && v <= max) return;
     param_error(prefix, key, "must be within " + format_real(min) + ".." + format_real(max) + " (got " + format_real(v) + ")");
 }
@@ -136,14 +142,14 @@ std::vector<ParamKeyInfo> parameter_keys() {
     return keys;
 }
 
-ParamValue parse_param_value(std::string_view key, std::string_view text, std::string_view prefix) {
+ParamValue parse_param_value(std::string_view key, std::string_view text, const KeySpelling& prefix) {
     const ParamInfo* info = nullptr;
     for (const DetectorInfo& d : detector_infos())
         if (!info) info = d.param(key);
     if (!info) {
         std::string known;
         for (const auto& k : parameter_keys()) known += (known.empty() ? "" : ", ") + std::string(k.key);
-        throw std::invalid_argument("unknown parameter " + std::string(prefix) + std::string(key) +
+        throw std::invalid_argument("unknown parameter " + prefix(key) +
                                     " (known: " + (known.empty() ? "none" : known) + ")");
     }
     const std::string t(text);
@@ -170,7 +176,7 @@ ParamValue parse_param_value(std::string_view key, std::string_view text, std::s
     detail::param_error(prefix, key, "has an unknown type");
 }
 
-void parse_param_assignment(std::string_view assignment, ParamValues& values, std::string_view prefix) {
+void parse_param_assignment(std::string_view assignment, ParamValues& values, const KeySpelling& prefix) {
     const auto eq = assignment.find('=');
     if (eq == std::string_view::npos || eq == 0)
         throw std::invalid_argument("expected KEY=VALUE, e.g. harris-window=11 (got '" + std::string(assignment) + "')");
@@ -178,7 +184,7 @@ void parse_param_assignment(std::string_view assignment, ParamValues& values, st
     values.set(key, parse_param_value(key, assignment.substr(eq + 1), prefix));
 }
 
-void check_detector_config(const DetectorConfig& config, std::string_view prefix) {
+void check_detector_config(const DetectorConfig& config, const KeySpelling& prefix) {
     with_detector_entry(config.name, [&](const auto& e) { (void)e.params_of(config.params, prefix); });
 }
 
@@ -190,14 +196,14 @@ DetectorConfig config_for(std::string_view name, const ParamValues& values) {
     return c;
 }
 
-void check_params_taken(std::span<const std::string> names, const ParamValues& values, std::string_view prefix) {
+void check_params_taken(std::span<const std::string> names, const ParamValues& values, const KeySpelling& prefix) {
     for (const auto& [key, value] : values) {
         bool taken = false;
         for (const std::string& n : names) taken = taken || detector_info(n).param(key) != nullptr;
         if (taken) continue;
         std::string list;
         for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-        throw std::invalid_argument("no detector run takes " + std::string(prefix) + key + " (detectors: " + list + ")");
+        throw std::invalid_argument("no detector run takes " + prefix(key) + " (detectors: " + list + ")");
     }
 }
 
@@ -214,7 +220,7 @@ std::optional<int> detector_radius(const DetectorConfig& config) {
     });
 }
 
-AnyDetector make_detector(const DetectorConfig& config, SensorSize size, std::string_view prefix) {
+AnyDetector make_detector(const DetectorConfig& config, SensorSize size, const KeySpelling& prefix) {
     return with_detector_entry(config.name, [&](const auto& e) {
         return AnyDetector(std::in_place_type<typename std::remove_cvref_t<decltype(e)>::Detector>,
                            e.make(size, e.params_of(config.params, prefix)));

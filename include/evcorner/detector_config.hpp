@@ -62,6 +62,21 @@ private:
 /// it: "harris_window" -> "harris-window" (underscores become hyphens).
 std::string param_key(std::string_view identifier);
 
+/// How error messages spell a parameter's or an option's key ("harris-window") for the
+/// caller that gave it: `prefix` before it ("--": the command line's --harris-window), and
+/// with `identifiers`, underscores for hyphens (a binding's keyword harris_window).
+struct KeySpelling {
+    std::string_view prefix;
+    bool identifiers = false;
+
+    constexpr KeySpelling(const char* p = "") noexcept : prefix(p) {}
+    constexpr KeySpelling(std::string_view p, bool as_identifiers) noexcept : prefix(p), identifiers(as_identifiers) {}
+    /// The key as the caller knows it.
+    [[nodiscard]] std::string operator()(std::string_view key) const;
+};
+/// Keys as keyword arguments name them (harris_window).
+inline constexpr KeySpelling kIdentifierKeys{"", true};
+
 /// A detector by name with the parameter values given (the others keep their defaults).
 struct DetectorConfig {
     std::string name = "efast";
@@ -77,8 +92,9 @@ enum class Split {
 
 /// What the registry says about one detector, for --help, checks and the bindings.
 struct DetectorInfo {
-    std::string_view name;     ///< the name used on the command line: "efast"
-    std::string_view summary;  ///< one line
+    std::string_view name;        ///< the name used on the command line: "efast"
+    std::string_view class_name;  ///< the C++ class's name ("EFast"), which bindings give their class
+    std::string_view summary;     ///< one line
     std::vector<ParamInfo> params;
     bool has_score = false;  ///< it reports a score per event (ScoredDetector)
     Split split = Split::none;

@@ -38,11 +38,11 @@ namespace evcorner {
 namespace detail {
 // "harris-window must be within 5..15 (got 3)": `prefix` spells the key as the caller
 // knows it ("--" on the command line).
-[[noreturn]] void param_error(std::string_view prefix, std::string_view key, const std::string& what);
-std::int64_t param_as_integer(std::string_view prefix, std::string_view key, const ParamValue& v);
-double param_as_real(std::string_view prefix, std::string_view key, const ParamValue& v);
-bool param_as_boolean(std::string_view prefix, std::string_view key, const ParamValue& v);
-void check_param_range(std::string_view prefix, std::string_view key, double v, double min, double max);
+[[noreturn]] void param_error(const KeySpelling& prefix, std::string_view key, const std::string& what);
+std::int64_t param_as_integer(const KeySpelling& prefix, std::string_view key, const ParamValue& v);
+double param_as_real(const KeySpelling& prefix, std::string_view key, const ParamValue& v);
+bool param_as_boolean(const KeySpelling& prefix, std::string_view key, const ParamValue& v);
+void check_param_range(const KeySpelling& prefix, std::string_view key, double v, double min, double max);
 }  // namespace detail
 
 /// One parameter: its key, the field of P it sets, its range and help.
@@ -81,7 +81,7 @@ struct ParamField {
     }
 
     /// Checks `v` (type, range) and stores it in `p`; throws std::invalid_argument naming the key.
-    void apply(P& p, const ParamValue& v, std::string_view prefix) const {
+    void apply(P& p, const ParamValue& v, const KeySpelling& prefix) const {
         (void)p, (void)v, (void)prefix;
         if constexpr (!std::is_empty_v<P>) {  // (an empty P has no fields: quiets -Warray-bounds)
             std::visit(
@@ -134,8 +134,9 @@ struct DetectorEntry {
     using Params = typename D::Params;
     static constexpr bool kHasScore = ScoredDetector<D>;
 
-    std::string_view name;     ///< the name on the command line
-    std::string_view summary;  ///< one line for --help
+    std::string_view name;        ///< the name on the command line
+    std::string_view class_name;  ///< D's name without its namespace ("EFast"): a binding's class
+    std::string_view summary;     ///< one line for --help
     std::vector<ParamField<Params>> params;
     /// How --threads may split the sensor; Split::none: not local (one thread only).
     Split split = Split::none;
@@ -147,15 +148,14 @@ struct DetectorEntry {
     /// Params from the values given: each key must be one of this detector's, each value
     /// of its type and within its range; throws std::invalid_argument naming the key (as
     /// prefix + key) and, for a key it does not take, the detector and the keys it takes.
-    [[nodiscard]] Params params_of(const ParamValues& values, std::string_view prefix = "") const {
+    [[nodiscard]] Params params_of(const ParamValues& values, const KeySpelling& prefix = {}) const {
         Params p{};
         for (const auto& [key, value] : values) {
             const ParamField<Params>* f = field(key);
             if (!f) {
                 std::string takes;
-                for (const auto& g : params) takes += (takes.empty() ? "" : ", ") + std::string(prefix) + std::string(g.key);
-                throw std::invalid_argument("detector '" + std::string(name) + "' takes no parameter " +
-                                            std::string(prefix) + key +
+                for (const auto& g : params) takes += (takes.empty() ? "" : ", ") + prefix(g.key);
+                throw std::invalid_argument("detector '" + std::string(name) + "' takes no parameter " + prefix(key) +
                                             (takes.empty() ? " (it takes none)" : " (it takes: " + takes + ")"));
             }
             f->apply(p, value, prefix);
@@ -186,6 +186,7 @@ struct DetectorEntry {
     [[nodiscard]] DetectorInfo info() const {
         DetectorInfo i;
         i.name = name;
+        i.class_name = class_name;
         i.summary = summary;
         for (const auto& f : params) i.params.push_back(f.info());
         i.has_score = kHasScore;

@@ -83,6 +83,7 @@ inline const auto& detector_registry() {
     static const std::tuple entries{
         DetectorEntry<EFast>{
             .name = "efast",
+            .class_name = "EFast",
             .summary = "eFAST (Mueggler et al., BMVC 2017): arcs on the SAE circles of radius 3 and 4",
             .params = {},
             .split = Split::by_polarity,
@@ -90,6 +91,7 @@ inline const auto& detector_registry() {
         },
         DetectorEntry<Harris>{
             .name = "harris",
+            .class_name = "Harris",
             .summary = "spatially-adaptive Harris (Mueggler et al., BMVC 2017, Sec. 3.2): newest Nl pixels of the window",
             .params = harris_patch_params<HarrisParams>(),
             .split = Split::by_polarity,
@@ -97,6 +99,7 @@ inline const auto& detector_registry() {
         },
         DetectorEntry<HarrisGlobal>{
             .name = "harris-global",
+            .class_name = "HarrisGlobal",
             .summary = "event-based Harris (Vasco et al., IROS 2016): newest N pixels of the sensor",
             .params = harris_score_params<HarrisGlobalParams>() +
                       std::vector{param("harris-n", &HarrisGlobalParams::n, 1, 2147483647,
@@ -107,6 +110,7 @@ inline const auto& detector_registry() {
         },
         DetectorEntry<ArcStar>{
             .name = "arcstar",
+            .class_name = "ArcStar",
             .summary = "Arc* (Alzugaray and Chli, RA-L 2018): 50 ms filter, then its arc test on the radius-3/4 circles, "
                        "majority arcs included",
             .params = arc_filter_params<ArcStarParams>(),
@@ -115,6 +119,7 @@ inline const auto& detector_registry() {
         },
         DetectorEntry<FaHarris>{
             .name = "fa-harris",
+            .class_name = "FaHarris",
             .summary = "FA-Harris (Li et al., IROS 2019): Arc* candidates refined by the adaptive Harris on the newest "
                        "filtered pixels",
             .params = arc_filter_params<FaHarrisParams>() + harris_patch_params<FaHarrisParams>(),
@@ -126,6 +131,7 @@ inline const auto& detector_registry() {
         },
         DetectorEntry<EFastHarris>{
             .name = "efast-harris",
+            .class_name = "EFastHarris",
             .summary = "eFAST -> Harris cascade (Mueggler et al., BMVC 2017, Sec. 4): eFAST corners the adaptive Harris "
                        "also scores above its threshold",
             .params = harris_patch_params<HarrisParams>(),
@@ -134,6 +140,7 @@ inline const auto& detector_registry() {
         },
         DetectorEntry<LuvHarris>{
             .name = "luvharris",
+            .class_name = "LuvHarris",
             .summary = "luvHarris (Glover et al., TPAMI 2021): TOS surface, Harris table refreshed at fixed points of the "
                        "stream (reproducible)",
             .params =
@@ -241,22 +248,23 @@ std::vector<ParamKeyInfo> parameter_keys();
 
 /// Reads `text` as a value of parameter `key` ("11", "0.04", "true"/"false"/"1"/"0");
 /// throws std::invalid_argument (naming prefix + key) for an unknown key or a bad value.
-ParamValue parse_param_value(std::string_view key, std::string_view text, std::string_view prefix = "");
+ParamValue parse_param_value(std::string_view key, std::string_view text, const KeySpelling& prefix = {});
 /// Reads "KEY=VALUE" (the command line's -p) into `values`.
-void parse_param_assignment(std::string_view assignment, ParamValues& values, std::string_view prefix = "");
+void parse_param_assignment(std::string_view assignment, ParamValues& values, const KeySpelling& prefix = {});
 
 /// Throws std::invalid_argument when `config` names an unknown detector, a key that
 /// detector does not take, or a value of the wrong type or out of range (messages name
 /// the key as prefix + key). Parameters whose valid range depends on another (Harris's
 /// nl <= window^2) are checked when the detector is built.
-void check_detector_config(const DetectorConfig& config, std::string_view prefix = "");
+void check_detector_config(const DetectorConfig& config, const KeySpelling& prefix = {});
 
 /// The values of `values` that detector `name` takes (for commands that run several
 /// detectors with one set of options).
 DetectorConfig config_for(std::string_view name, const ParamValues& values);
 
 /// Throws std::invalid_argument when a key of `values` is taken by none of `names`.
-void check_params_taken(std::span<const std::string> names, const ParamValues& values, std::string_view prefix = "");
+void check_params_taken(std::span<const std::string> names, const ParamValues& values,
+                        const KeySpelling& prefix = {});
 
 /// Bytes of state the configured detector needs over `size` (its static state_bytes());
 /// throws as check_detector_config() does.
@@ -274,7 +282,7 @@ std::optional<int> detector_radius(const DetectorConfig& config);
 /// allocating, StateTooLarge (state_memory.hpp) when its state needs more memory than
 /// available_memory_bytes() (e.g. "a 65536x65536 sensor needs 68.7 GB for efast's state
 /// (16 B per pixel); 21.3 GB is available").
-AnyDetector make_detector(const DetectorConfig& config, SensorSize size, std::string_view prefix = "");
+AnyDetector make_detector(const DetectorConfig& config, SensorSize size, const KeySpelling& prefix = {});
 inline AnyDetector make_detector(std::string_view name, SensorSize size) {
     return make_detector(DetectorConfig{std::string(name), {}}, size);
 }

@@ -1,5 +1,6 @@
 """Detectors (one class per registry entry), one-call detection, evaluation, simulation."""
 
+import inspect
 import os
 
 import numpy as np
@@ -18,6 +19,52 @@ def detectors():
     return _evcorner.detectors()
 
 
+def _detector_repr(self):
+    """The call that builds this detector: its class, sensor and the parameters given (in the
+    registry's order)."""
+    cls = type(self)
+    order = [p["name"] for d in _evcorner.detectors() if d["name"] == self.name for p in d["params"]]
+    given = self.params
+    params = {k: given[k] for k in sorted(given, key=lambda k: order.index(k) if k in order else len(order))}
+    if getattr(cls, "registry_name", None) == self.name:
+        text = "".join(f", {k}={v!r}" for k, v in params.items())
+        return f"{cls.__name__}({self.sensor[0]}, {self.sensor[1]}{text})"
+    return f"{cls.__name__}({self.name!r}, {self.sensor[0]}, {self.sensor[1]}, {params!r})"
+
+
+def _detector_copy(self):
+    new = type(self).__new__(type(self))
+    Detector.__init__(new, self)
+    return new
+
+
+def _detector_deepcopy(self, memo):
+    new = _detector_copy(self)
+    memo[id(self)] = new
+    return new
+
+
+def _detector_reduce(self):
+    if self.events:
+        raise TypeError(f"cannot pickle {self!r} after it has processed events ({self.events}): the state of a C++ "
+                        f"detector has no serialised form; copy.deepcopy() copies it within a process, and a "
+                        f"detector that has processed nothing (or after reset()) pickles")
+    return (_rebuild, (type(self), self.name, self.sensor, self.params))
+
+
+def _rebuild(cls, name, sensor, params):
+    if getattr(cls, "registry_name", None) == name:
+        return cls(*sensor, **params)
+    return cls(name, *sensor, params)
+
+
+# Copies carry the state (the C++ copy constructor); pickles carry the configuration.
+Detector.__repr__ = _detector_repr
+Detector.__copy__ = _detector_copy
+Detector.__deepcopy__ = _detector_deepcopy
+Detector.__reduce__ = _detector_reduce
+
+
 def _make_class(info):
     name = info["name"]
     lines = [
@@ -31,9 +78,19 @@ def _make_class(info):
         Detector.__init__(self, name, width, height, params)
 
     __init__.__doc__ = f"{info['class_name']}(width, height, **params): the '{name}' detector on a width x height sensor."
+    # help() and inspect show the registry's keywords with their defaults and types.
+    P = inspect.Parameter
+    types = {"integer": int, "number": float, "true/false": bool}
+    __init__.__signature__ = inspect.Signature(
+        [P("self", P.POSITIONAL_OR_KEYWORD), P("width", P.POSITIONAL_OR_KEYWORD, annotation=int),
+         P("height", P.POSITIONAL_OR_KEYWORD, annotation=int)]
+        + [P(p["name"], P.KEYWORD_ONLY, default=p["default"], annotation=types.get(p["type"], P.empty))
+           for p in info["params"]],
+        return_annotation=None)
     doc = (
         f"{info['summary']}\n\n"
-        f"Registry name '{name}'. process(events, out=None) -> uint8 mask; state is kept across calls."
+        f"Registry name '{name}'. process(events, out=None) -> uint8 mask; state is kept across calls, "
+        f"and events must come in time order across them (InvalidEvent otherwise; reset() starts anew)."
         + (" process_scored(events) -> (mask, scores)." if info["has_score"] else "")
         + "\n\nKeyword parameters (default, range): "
         + ("\n    " + "\n    ".join(lines) if lines else "none")
@@ -52,7 +109,8 @@ def detect(events, detector="efast", sensor=None, scores=False, out=None, **para
     """Runs `detector` (a registry name) over EVENT_DTYPE `events` in one call, read in
     place: returns the uint8 mask (1 = corner), or (mask, scores) with scores=True.
     `sensor` = (width, height); None: the one the events carry (evcorner.Events, e.g. from
-    read()), else the DAVIS240C's 240x180 as in the CLI."""
+    read()), else the DAVIS240C's 240x180 as in the CLI. Events off the sensor or out of time
+    order raise evcorner.InvalidEvent naming the event."""
     if sensor is None:
         sensor = getattr(events, "sensor", None) or DAVIS240
     w, h = _size(sensor, "sensor")

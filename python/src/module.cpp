@@ -14,8 +14,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -33,9 +35,11 @@
 #include "evcorner/event.hpp"
 #include "evcorner/event_check.hpp"
 #include "evcorner/io/event_reader.hpp"
+#include "evcorner/io/event_checks.hpp"
 #include "evcorner/io/event_writer.hpp"
 #include "evcorner/io/formats.hpp"
 #include "evcorner/io/open.hpp"
+#include "evcorner/parallel_detect.hpp"
 #include "evcorner/pipeline/detect.hpp"
 #include "evcorner/registry.hpp"
 #include "evcorner/scored_detector.hpp"
@@ -213,47 +217,6 @@ ParamValues params_from(const py::dict& kw) {
     return values;
 }
 
-/// A registry message with keys spelt as Python keywords ("harris-window" -> "harris_window").
-std::string pythonic(std::string message) {
-    std::vector<std::string_view> keys;
-    for (const DetectorInfo& info : detector_infos())
-        for (const ParamInfo& p : info.params) keys.push_back(p.key);
-    std::sort(keys.begin(), keys.end(), [](auto a, auto b) { return a.size() > b.size(); });
-    for (const std::string_view key : keys) {
-        const std::string id = [&] {
-            std::string s(key);
-            std::replace(s.begin(), s.end(), '-', '_');
-            return s;
-        }();
-        for (std::size_t at = message.find(key); at != std::string::npos; at = message.find(key, at + id.size()))
-            message.replace(at, key.size(), id);
-    }
-    return message;
-}
-
-template <class F>
-decltype(auto) pythonic_errors(F&& f) {
-    try {
-        return f();
-    } catch (const InvalidEvent&) {
-        throw;
-    } catch (const std::invalid_argument& e) {
-        throw py::value_error(pythonic(e.what()));
-    }
-}
-
-/// The C++ class name of D ("EFast"), from the compiler: the Python class takes it.
-template <class T>
-std::string cpp_class_name() {
-    const std::string_view f = __PRETTY_FUNCTION__;  // "... [with T = evcorner::EFast; ...]" (GCC) / "[T = ...]"
-    const auto b = f.find("T = ");
-    if (b == std::string_view::npos) return {};
-    std::string_view s = f.substr(b + 4);
-    s = s.substr(0, s.find_first_of(";]"));
-    if (const auto c = s.rfind("::"); c != std::string_view::npos) s = s.substr(c + 2);
-    return std::string(s);
-}
-
 /// (width, height), or None.
 py::object size_or_none(const std::optional<SensorSize>& s) {
     if (!s) return py::none();
@@ -272,24 +235,75 @@ void def_size_property(py::class_<io::ReaderOptions>& c, const char* name) {
 
 SensorSize sensor_of(int width, int height) { return SensorSize{width, height}; }
 
+/// An event that comes before the one it follows (raised as evcorner.InvalidEvent).
+class EventsOutOfOrder : public std::invalid_argument {
+    using std::invalid_argument::invalid_argument;
+};
+
+/// The array changed while a call was reading it (raised as RuntimeError).
+class EventsChanged : public std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/// Index of the first event of `ev` whose time is below the one before it (`prev` before
+/// the first), or ev.size(). Blocks are tested without a branch per event.
+std::size_t first_backwards(std::span<const Event> ev, std::int64_t prev) noexcept {
+    if (ev.empty()) return 0;
+    if (ev[0].t < prev) return 0;
+    constexpr std::size_t kStep = 64;
+    for (std::size_t at = 1; at < ev.size(); at += kStep) {
+        const std::size_t end = std::min(ev.size(), at + kStep);
+        bool back = false;
+        for (std::size_t i = at; i < end; ++i) back |= ev[i].t < ev[i - 1].t;  // independent: pipelined
+        if (back) [[unlikely]]
+            for (std::size_t i = at; i < end; ++i)
+                if (ev[i].t < ev[i - 1].t) return i;
+    }
+    return ev.size();
+}
+
+std::string describe_event(const Event& e, std::size_t index) {
+    return "event " + std::to_string(index) + " (t=" + std::to_string(e.t) + " x=" + std::to_string(e.x) +
+           " y=" + std::to_string(e.y) + " p=" + std::to_string(e.p) + ")";
+}
+
 /// One registered detector, stateful across calls.
+///
+/// A call checks every event of the array in place (on the sensor, polarity, time order,
+/// also against the last event of the previous call) and raises before touching the state
+/// when one is bad. The detector then reads only private copies of the array, a block at
+/// a time, each checked again once copied: another thread writing to the array while the
+/// GIL is released can make the result meaningless (EventsChanged when it breaks a check)
+/// but never lets the detector read an event it cannot take.
 class PyDetector {
 public:
+    /// Events per private block: small enough to stay in the L1/L2 cache between the copy,
+    /// its check and the detector's pass.
+    static constexpr std::size_t kBlock = 2048;
+
     PyDetector(std::string name, int width, int height, const py::dict& params)
         : config_{std::move(name), params_from(params)},
           size_(sensor_of(width, height)),
-          det_(pythonic_errors([&] { return make_detector(config_, size_); })) {}
+          det_(make_detector(config_, size_, kIdentifierKeys)) {}
+
+    /// A copy of `o` with its state: it goes on from where `o` is.
+    PyDetector(const PyDetector& o) : PyDetector(o, std::lock_guard(o.mutex_)) {}
+    PyDetector& operator=(const PyDetector&) = delete;
 
     py::object process(py::handle events, py::handle out) {
         const std::span<const Event> ev = events_view(events);
         py::array_t<std::uint8_t> mask = output_array<std::uint8_t>(out, ev.size(), "out");
         const std::span<std::uint8_t> flags(mask.mutable_data(), ev.size());
-        std::size_t corners = 0;
         {
             py::gil_scoped_release release;
             const std::lock_guard lock(mutex_);
-            corners = detect(det_, ev, flags);
-            count(ev, corners);
+            std::visit(
+                [&](auto& d) {
+                    run(d, ev, [&](std::span<const Event> block, std::size_t at, const TimeSpan& span) {
+                        return evcorner::detail::run_batch(d, block, flags.subspan(at, block.size()), span);
+                    });
+                },
+                det_);
         }
         return mask;
     }
@@ -305,30 +319,32 @@ public:
         {
             py::gil_scoped_release release;
             const std::lock_guard lock(mutex_);
-            const std::size_t corners = std::visit(
-                [&](auto& d) -> std::size_t {
+            std::visit(
+                [&](auto& d) {
                     if constexpr (ScoredDetector<std::remove_cvref_t<decltype(d)>>)
-                        return detect(d, ev, flags, sc);
-                    else
-                        return 0;  // unreachable: has_score() said so
+                        run(d, ev, [&](std::span<const Event> block, std::size_t at, const TimeSpan&) {
+                            return detect_unchecked(d, block, flags.subspan(at, block.size()),
+                                                    sc.subspan(at, block.size()));
+                        });
                 },
-                det_);
-            count(ev, corners);
+                det_);  // (a detector without a score was refused above)
         }
         return py::make_tuple(std::move(mask), std::move(scores));
     }
 
     void reset() {
         const std::lock_guard lock(mutex_);
-        det_ = make_detector(config_, size_);
+        det_ = make_detector(config_, size_, kIdentifierKeys);
         events_ = corners_ = 0;
         last_address_ = 0;
+        last_t_.reset();
     }
 
     [[nodiscard]] std::string name() const { return config_.name; }
     [[nodiscard]] py::tuple sensor() const { return py::make_tuple(size_.width, size_.height); }
     [[nodiscard]] bool scored() const { return has_score(det_); }
     [[nodiscard]] std::size_t memory() const { return memory_bytes(det_); }
+    [[nodiscard]] py::object last_time() const { return last_t_ ? py::object(py::int_(*last_t_)) : py::none(); }
     [[nodiscard]] py::dict params() const {
         py::dict d;
         for (const auto& [key, value] : config_.params) {
@@ -342,16 +358,70 @@ public:
     std::uintptr_t last_address_ = 0;  ///< where the last call read its events (the zero-copy test)
 
 private:
-    void count(std::span<const Event> ev, std::size_t corners) {
-        events_ += ev.size();
-        corners_ += corners;
+    PyDetector(const PyDetector& o, const std::lock_guard<std::mutex>&)
+        : events_(o.events_),
+          corners_(o.corners_),
+          last_address_(o.last_address_),
+          config_(o.config_),
+          size_(o.size_),
+          det_(o.det_),
+          last_t_(o.last_t_) {}
+
+    /// Checks `ev` in place, then runs `step(block, at, span)` on checked private copies of
+    /// its blocks (block = the copy of ev[at, at + block.size())).
+    template <class D, class Step>
+    void run(D& det, std::span<const Event> ev, Step&& step) {
+        const EventLimits limits = det.limits();
+        const std::int64_t before = last_t_.value_or(std::numeric_limits<std::int64_t>::min());
+        // Both checks a block at a time, so that the second reads the block from the cache.
+        for (std::size_t at = 0; at < ev.size(); at += kBlock) {
+            const std::span<const Event> part = ev.subspan(at, std::min(kBlock, ev.size() - at));
+            TimeSpan span;
+            const std::size_t bad = first_invalid_event(part, limits, span);
+            const std::size_t back = first_backwards(part.first(bad), at == 0 ? before : ev[at - 1].t);
+            if (back < bad) throw_backwards(ev, at + back);
+            if (bad != part.size()) throw InvalidEvent(part[bad], limits, at + bad);
+        }
         last_address_ = reinterpret_cast<std::uintptr_t>(ev.data());
+        if (block_.size() < std::min(ev.size(), kBlock)) block_.resize(kBlock);
+        for (std::size_t at = 0; at < ev.size(); at += kBlock) {
+            const std::size_t n = std::min(kBlock, ev.size() - at);
+            const std::span<Event> copy(block_.data(), n);
+            std::memcpy(copy.data(), ev.data() + at, n * sizeof(Event));
+            if (at + n < ev.size()) {
+                // The next block on its way to the L2 cache while the detector runs on this one.
+                const char* next = reinterpret_cast<const char*>(ev.data() + at + n);
+                const std::size_t bytes = std::min(kBlock, ev.size() - at - n) * sizeof(Event);
+                for (std::size_t b = 0; b < bytes; b += 64) __builtin_prefetch(next + b, 0, 2);
+            }
+            TimeSpan span;
+            const std::size_t bad = first_invalid_event(copy, limits, span);
+            const std::size_t back = first_backwards(copy.first(bad), last_t_.value_or(before));
+            if (bad != n || back != n) [[unlikely]]
+                throw EventsChanged("events: " + describe_event(copy[std::min(bad, back)], at + std::min(bad, back)) +
+                                    " changed after the call checked it (another thread wrote to the array); the " +
+                                    std::to_string(at) + " events before its block were processed");
+            corners_ += step(std::span<const Event>(copy), at, span);
+            events_ += n;
+            last_t_ = copy[n - 1].t;
+        }
+    }
+
+    [[noreturn]] void throw_backwards(std::span<const Event> ev, std::size_t i) const {
+        const std::int64_t previous = i > 0 ? ev[i - 1].t : *last_t_;
+        std::string m = "events: " + describe_event(ev[i], i) + ": " + io::backwards_message(previous, ev[i].t);
+        if (i == 0)
+            m += "; the previous event is the last one of the detector's previous call (event " +
+                 std::to_string(events_ - 1) + " of its stream; reset() starts a new stream)";
+        throw EventsOutOfOrder(m);
     }
 
     DetectorConfig config_;
     SensorSize size_;
     AnyDetector det_;
-    std::mutex mutex_;
+    std::optional<std::int64_t> last_t_;  ///< the time of the last event taken, if any
+    std::vector<Event> block_;            ///< the private copy the detector reads
+    mutable std::mutex mutex_;
 };
 
 /// An open event file, read in chunks (by count or up to a time) in constant memory.
@@ -535,26 +605,22 @@ py::dict detect_file_py(const std::string& input, const std::string& output, con
     options.with_score = with_score;
     options.threads = threads;
     options.allow_damaged = allow_damaged;
-    const pipeline::DetectSummary s = pythonic_errors([&] {
-        pipeline::check_detect_options(options);
+    options.param_prefix = kIdentifierKeys;  // messages name with_score=, harris_window=
+    pipeline::check_detect_options(options);
+    pipeline::DetectSummary s;
+    {
         py::gil_scoped_release release;
-        return pipeline::detect_file(files, options);
-    });
+        s = pipeline::detect_file(files, options);
+    }
     return summary_dict(s, input, params);
 }
 
 py::list detector_list() {
-    std::vector<std::pair<std::string, std::string>> classes;
-    for_each_detector_entry([&](const auto& e) {
-        using D = typename std::remove_cvref_t<decltype(e)>::Detector;
-        classes.emplace_back(std::string(e.name), cpp_class_name<D>());
-    });
     py::list out;
     for (const DetectorInfo& info : detector_infos()) {
         py::dict d;
         d["name"] = std::string(info.name);
-        for (const auto& [n, c] : classes)
-            if (n == info.name) d["class_name"] = c;
+        d["class_name"] = std::string(info.class_name);
         d["summary"] = std::string(info.summary);
         d["has_score"] = info.has_score;
         d["local"] = info.local();
@@ -579,7 +645,10 @@ py::list detector_list() {
 }
 
 py::tuple label_py(py::handle corners, const eval::FeatureTrackParams& params) {
-    const std::span<const Event> ev = events_view(corners, "corners");
+    // A private copy (corners are few): another thread writing to the array while the GIL
+    // is released cannot change what the labelling indexes by.
+    const std::span<const Event> view = events_view(corners, "corners");
+    const std::vector<Event> ev(view.begin(), view.end());
     eval::FeatureTrackResult r;
     {
         py::gil_scoped_release release;
@@ -615,16 +684,15 @@ py::tuple simulate_py(const std::string& scene, bool is_path) {
 py::dict evaluate_truth_py(py::handle corners, const std::string& truth, double radius, std::int64_t tolerance_us,
                            const std::string& credit, const std::string& interpolation,
                            std::optional<std::vector<double>> speed_bins) {
-    const std::span<const Event> ev = events_view(corners, "corners");
+    const std::span<const Event> view = events_view(corners, "corners");
+    const std::vector<Event> ev(view.begin(), view.end());  // private, as in label_py
     eval::TruthMatchParams p;
     p.radius = radius;
     p.tolerance_us = tolerance_us;
-    pythonic_errors([&] {
-        p.credit = eval::parse_credit(credit);
-        p.interpolation = eval::parse_interpolation(interpolation);
-        if (speed_bins) p.speed_edges = std::move(*speed_bins);
-        eval::validate(p);
-    });
+    p.credit = eval::parse_credit(credit);
+    p.interpolation = eval::parse_interpolation(interpolation);
+    if (speed_bins) p.speed_edges = std::move(*speed_bins);
+    eval::validate(p);
     eval::TruthMatchResult r;
     eval::ErrorSummary err;
     {
@@ -697,6 +765,13 @@ PYBIND11_MODULE(_evcorner, m) {
             too_large(e.what());
         }
     });
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const EventsOutOfOrder& e) {
+            invalid_event(e.what());
+        }
+    });
 
     m.attr("EVENT_DTYPE") = event_dtype();
     m.def("_event_layout", [] {
@@ -713,6 +788,8 @@ PYBIND11_MODULE(_evcorner, m) {
     py::class_<PyDetector>(m, "Detector")
         .def(py::init<std::string, int, int, py::dict>(), py::arg("name"), py::arg("width"), py::arg("height"),
              py::arg("params"))
+        .def(py::init<const PyDetector&>(), py::arg("other"),
+             "A copy of `other`, its state included: it goes on from where `other` is.")
         .def("process", &PyDetector::process, py::arg("events"), py::arg("out") = py::none())
         .def("process_scored", &PyDetector::process_scored, py::arg("events"), py::arg("out") = py::none(),
              py::arg("scores") = py::none())
@@ -724,6 +801,9 @@ PYBIND11_MODULE(_evcorner, m) {
         .def_property_readonly("params", &PyDetector::params)
         .def_readonly("events", &PyDetector::events_)
         .def_readonly("corners", &PyDetector::corners_)
+        .def_property_readonly("last_time", &PyDetector::last_time,
+                               "The time of the last event processed (us), or None; the next call's events "
+                               "may not be earlier.")
         .def_readonly("last_address", &PyDetector::last_address_);
 
     py::class_<io::ReaderOptions> reader_options(m, "ReaderOptions");
@@ -785,24 +865,15 @@ PYBIND11_MODULE(_evcorner, m) {
         .def_property(
             "overlap", [](const eval::FeatureTrackParams& p) { return std::string(eval::to_string(p.overlap)); },
             [](eval::FeatureTrackParams& p, const std::string& s) {
-                pythonic_errors([&] { p.overlap = eval::parse_track_overlap(s); });
+                p.overlap = eval::parse_track_overlap(s);
             })
         .def_readwrite("cell_size", &eval::FeatureTrackParams::cell_size);
-    m.def("label", [](py::handle corners, const eval::FeatureTrackParams& p) {
-        return pythonic_errors([&] { return label_py(corners, p); });
-    });
-    m.def("reduction_rate", &eval::reduction_rate, py::arg("events"), py::arg("corners"));
-    m.def("ft_percent", &eval::ft_percent, py::arg("corners"), py::arg("on_track"));
+    m.def("label", &label_py);
+    m.def("reduction_rate", &eval::reduction_rate, py::arg("n_events"), py::arg("n_corners"),
+          "The reduction rate in percent from two counts: 100 (1 - n_corners / n_events); 0 for no events.");
+    m.def("ft_percent", &eval::ft_percent, py::arg("n_corners"), py::arg("n_on_track"),
+          "The feature-track percentage from two counts: 100 n_on_track / n_corners; 0 for no corners.");
     m.def("simulate", &simulate_py, py::arg("scene"), py::arg("is_path"));
-    m.def(
-        "evaluate_truth",
-        [](py::handle corners, const std::string& truth, double radius, std::int64_t tolerance_us,
-           const std::string& credit, const std::string& interpolation, std::optional<std::vector<double>> speed_bins) {
-            return pythonic_errors([&] {
-                return evaluate_truth_py(corners, truth, radius, tolerance_us, credit, interpolation,
-                                         std::move(speed_bins));
-            });
-        },
-        py::arg("corners"), py::arg("truth"), py::arg("radius"), py::arg("tolerance_us"), py::arg("credit"),
-        py::arg("interpolation"), py::arg("speed_bins") = py::none());
+    m.def("evaluate_truth", &evaluate_truth_py, py::arg("corners"), py::arg("truth"), py::arg("radius"),
+          py::arg("tolerance_us"), py::arg("credit"), py::arg("interpolation"), py::arg("speed_bins") = py::none());
 }

@@ -101,20 +101,22 @@ void check_detect_options(const DetectOptions& o) {
         std::string scored;
         for (const DetectorInfo& d : detector_infos())
             if (d.has_score) scored += (scored.empty() ? "" : ", ") + std::string(d.name);
-        throw std::invalid_argument("--with-score: detector '" + o.detector.name + "' has no score (" +
+        throw std::invalid_argument(o.param_prefix("with-score") + ": detector '" + o.detector.name + "' has no score (" +
                                     (scored.empty() ? "none has" : scored + " have one") + ")");
     }
     if (o.threads > 1 && !info.local()) {
         std::string local;
         for (const DetectorInfo& d : detector_infos())
             if (d.local()) local += (local.empty() ? "" : ", ") + std::string(d.name);
-        throw std::invalid_argument("--threads: detector '" + o.detector.name + "' is not local (" +
+        throw std::invalid_argument(o.param_prefix("threads") + ": detector '" + o.detector.name + "' is not local (" +
                                     std::string(info.not_local) + "); " + local + " split the sensor");
     }
-    if (o.threads > 1 && o.with_score) throw std::invalid_argument("--threads: --with-score needs one thread");
+    if (o.threads > 1 && o.with_score)
+        throw std::invalid_argument(o.param_prefix("threads") + ": " + o.param_prefix("with-score") + " needs one thread");
     if (o.nms) {
         if (!info.has_score)
-            throw std::invalid_argument("--nms: detector '" + o.detector.name + "' has no score to suppress by");
+            throw std::invalid_argument(o.param_prefix("nms") + ": detector '" + o.detector.name +
+                                        "' has no score to suppress by");
         check_nms_params(*o.nms);
     }
 }
@@ -310,8 +312,9 @@ DetectSummary detect_file(const DetectFiles& f, const DetectOptions& o, const Pr
     check_detect_options(o);
     const std::string to = f.output.empty() ? std::string() : io::resolve_output_format(f.output, f.to);
     if (o.with_score && to == "aedat4")
-        throw std::invalid_argument("--with-score: AEDAT 4.0 event packets have no field for a score (formats "
-                                    "that carry scores: " + std::string(io::kScoredOutputFormats) + ")");
+        throw std::invalid_argument(o.param_prefix("with-score") +
+                                    ": AEDAT 4.0 event packets have no field for a score (formats that carry "
+                                    "scores: " + std::string(io::kScoredOutputFormats) + ")");
     const std::unique_ptr<io::EventReader> reader = io::open_event_reader(f.input, f.reader, f.format);
     const SensorSize size = reader->sensor().value_or(kDavis240);
     // The output records the sensor size the detector ran on where it has a field for it.

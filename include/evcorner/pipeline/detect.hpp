@@ -95,8 +95,9 @@ struct DetectOptions {
     /// threads > 1 too: the part halo grows by its radius; output identical to one thread).
     std::optional<NmsParams> nms;
     std::size_t batch = std::size_t{1} << 16;  ///< events per read, 1..65536
-    /// How error messages spell parameter keys ("--" on the command line).
-    std::string param_prefix;
+    /// How error messages spell parameter keys and the options of this struct (with_score,
+    /// threads, nms): "--with-score" on the command line, kIdentifierKeys in a binding.
+    KeySpelling param_prefix;
 };
 
 /// After every batch written: how far the run is.
