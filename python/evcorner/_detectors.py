@@ -182,7 +182,7 @@ def evaluate_truth(events, corners, truth, radius=3.5, tolerance_us=1000, credit
     precision_percent, truth_samples, recalled, recall_percent, loc_median_px,
     loc_mean_px, loc_p90_px, speed_bins) plus corner_events, events (len(events), or None),
     is_true (uint8 per corner event) and errors (float32 px per true positive, in order)."""
-    if isinstance(corners, np.ndarray) and corners.dtype == _evcorner.EVENT_DTYPE:
+    if isinstance(corners, np.ndarray) and corners.dtype.names and _evcorner._has_event_layout(corners.dtype):
         corner_events = corners
     else:
         if events is None:

@@ -80,13 +80,19 @@ def test_equals_eval_truth(cli, scene, tmp_path, detector, match, options):
     assert np.all(r["errors"] <= match.get("radius", 3.5))
 
 
-def test_mask_and_corner_events_agree(scene):
+def test_mask_and_corner_events_agree(scene, tmp_path):
     events, mask, by_mask = python_eval(scene, "efast")
     by_events = evcorner.evaluate_truth(None, events[mask.view(bool)], scene / "scene.truth.csv")
     assert by_events["events"] is None
     for key in KEYS + ("corner_events",):
         assert by_events[key] == by_mask[key], key
     np.testing.assert_array_equal(by_events["is_true"], by_mask["is_true"])
+    # the corner events as evcorner's own .npy gives them back (the '_' padding field)
+    corners_npy = tmp_path / "corners.npy"
+    evcorner.write(corners_npy, events[mask.view(bool)])
+    from_npy = evcorner.evaluate_truth(None, np.load(corners_npy, mmap_mode="r"), scene / "scene.truth.csv")
+    for key in KEYS + ("corner_events",):
+        assert from_npy[key] == by_mask[key], key
     # a bool mask is the same as the uint8 one; no corners: nothing true, nothing recalled
     assert evcorner.evaluate_truth(events, mask.view(bool), scene / "scene.truth.csv")["recalled"] == by_mask["recalled"]
     none = evcorner.evaluate_truth(events, np.zeros(len(events), np.uint8), scene / "scene.truth.csv")
