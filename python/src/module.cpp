@@ -807,7 +807,12 @@ PYBIND11_MODULE(_evcorner, m) {
         .def_readonly("last_address", &PyDetector::last_address_);
 
     py::class_<io::ReaderOptions> reader_options(m, "ReaderOptions");
-    reader_options.def(py::init<>());
+    // Messages name the options as this package's keywords (sensor=, time_unit, ...).
+    reader_options.def(py::init([] {
+        io::ReaderOptions o;
+        o.keyword_spelling = true;
+        return o;
+    }));
     def_size_property<&io::ReaderOptions::sensor>(reader_options, "sensor");
     def_size_property<&io::ReaderOptions::fallback_sensor>(reader_options, "fallback_sensor");
     reader_options.def_readwrite("skip_invalid", &io::ReaderOptions::skip_invalid);

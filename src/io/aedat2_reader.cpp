@@ -96,12 +96,14 @@ Aedat2Reader::Aedat2Reader(InputFile file, ReaderOptions options)
     } else {
         fail(offset(), chip_.empty()
                            ? fmt::format("the header has no '# AEChip:' line, so the address layout and sensor "
-                                         "size are unknown; pass --chip NAME ({}) or --size WxH to read DAVIS "
+                                         "size are unknown; pass {} NAME ({}) or {} WxH to read DAVIS "
                                          "addresses",
-                                         kKnownChips)
+                                         option_spelling(this->options(), "--chip"), kKnownChips,
+                                         option_spelling(this->options(), "--size"))
                            : fmt::format("unknown AEChip '{}': the address layout and sensor size are unknown; "
-                                         "pass --chip NAME ({}) or --size WxH to read DAVIS addresses",
-                                         chip_, kKnownChips));
+                                         "pass {} NAME ({}) or {} WxH to read DAVIS addresses",
+                                         chip_, option_spelling(this->options(), "--chip"), kKnownChips,
+                                         option_spelling(this->options(), "--size")));
     }
     if (forced.empty()) check_layout();
 }
@@ -137,13 +139,14 @@ void Aedat2Reader::check_layout() {
     if (off * 2 > words)
         fail(offset(), fmt::format("{} of the first {} address words decode outside the {}x{} sensor of the "
                                    "header's AEChip {}: that line does not name the camera that recorded the "
-                                   "file; pass --chip NAME ({}) or --size WxH",
-                                   off, words, s.width, s.height, chip, kKnownChips));
+                                   "file; pass {} NAME ({}) or {} WxH",
+                                   off, words, s.width, s.height, chip, option_spelling(this->options(), "--chip"),
+                                   kKnownChips, option_spelling(this->options(), "--size")));
     if (layout_ == Layout::davis && words >= kMinDvs128Evidence && low16 * 2 > words)
         fail(offset(), fmt::format("{} of the first {} address words have only their low 16 bits set, as DVS128 "
                                    "addresses do, not DAVIS ones: the header's AEChip {} does not name the "
-                                   "camera that recorded the file; pass --chip NAME (e.g. --chip DVS128)",
-                                   low16, words, chip));
+                                   "camera that recorded the file; pass {} NAME (e.g. DVS128)",
+                                   low16, words, chip, option_spelling(this->options(), "--chip")));
 }
 
 bool Aedat2Reader::decode() {

@@ -80,7 +80,7 @@ void BinaryReader::fail(std::uint64_t at, const std::string& reason) const {
 }
 
 void BinaryReader::outside(std::uint32_t x, std::uint32_t y, std::uint64_t at) {
-    if (!options_.skip_invalid) fail(at, outside_sensor_message(x, y, sensor_));
+    if (!options_.skip_invalid) fail(at, outside_sensor_message(x, y, sensor_, options_.keyword_spelling));
     skips_.skip(n_);
 }
 

@@ -101,15 +101,19 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
                     unit = TimeUnit::s;
                     whole = false;
                 } else if (has_point) {
-                    why = "a decimal point in a time column whose first time was an integer: times are "
-                          "microseconds when the first has no decimal point, else seconds (--time-unit sets the unit)";
+                    why = options_.keyword_spelling
+                          ? "a decimal point in a time column whose first time was an integer: times are "
+                            "microseconds when the first has no decimal point, else seconds (time_unit sets the unit)"
+                          : "a decimal point in a time column whose first time was an integer: times are "
+                            "microseconds when the first has no decimal point, else seconds (--time-unit sets the unit)";
                     return false;
                 }
             }
             const detail::DecimalTime t = detail::parse_decimal_time(f, fe, unit, whole);
             if (t.error != nullptr) {
                 why = whole && unit_given_ && has_point && t.error != detail::kNotATimestamp
-                          ? "a fraction of a microsecond, but --time-unit is us (whole microseconds)"
+                          ? (options_.keyword_spelling ? "a fraction of a microsecond, but time_unit is us (whole microseconds)"
+                                                       : "a fraction of a microsecond, but --time-unit is us (whole microseconds)")
                           : t.error;
                 return false;
             }
@@ -181,7 +185,7 @@ std::size_t CsvReader::read(std::span<Event> out) {
             if (!parse(b, e, ev, why)) lines_.fail(b, e, why);
             if (ev.t < last_t_) lines_.fail(b, e, backwards_message(last_t_, ev.t));
             if (sensor_ && !sensor_->contains(ev)) {
-                if (!options_.skip_invalid) lines_.fail(b, e, outside_sensor_message(ev.x, ev.y, sensor_));
+                if (!options_.skip_invalid) lines_.fail(b, e, outside_sensor_message(ev.x, ev.y, sensor_, options_.keyword_spelling));
                 skips_.skip(n);
                 continue;
             }

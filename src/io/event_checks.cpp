@@ -4,11 +4,12 @@
 
 namespace evcorner::io {
 
-std::string outside_sensor_message(std::int64_t x, std::int64_t y, const std::optional<SensorSize>& sensor) {
+std::string outside_sensor_message(std::int64_t x, std::int64_t y, const std::optional<SensorSize>& sensor,
+                                   bool keyword_spelling) {
     if (sensor)
-        return fmt::format("event at x={} y={} lies outside the {}x{} sensor (set --size, or --skip-invalid to skip "
-                           "such events)",
-                           x, y, sensor->width, sensor->height);
+        return fmt::format("event at x={} y={} lies outside the {}x{} sensor (set {}, or {} to skip such events)", x,
+                           y, sensor->width, sensor->height, keyword_spelling ? "sensor=" : "--size",
+                           keyword_spelling ? "skip_invalid=True" : "--skip-invalid");
     return fmt::format("event at x={} y={} does not fit 16-bit coordinates", x, y);
 }
 

@@ -133,13 +133,24 @@ const std::string& input_format_names() {
 
 std::span<const ReaderOptionInfo> reader_option_infos() noexcept { return kReaderOptions; }
 
+std::string option_spelling(const ReaderOptions& o, std::string_view flag) {
+    if (!o.keyword_spelling) return std::string(flag);
+    if (flag == "--size") return "sensor";
+    for (const ReaderOptionInfo& r : kReaderOptions)
+        if (r.flag == flag) return std::string(r.keyword);
+    std::string k(flag.substr(flag.starts_with("--") ? 2 : 0));  // --skip-invalid: skip_invalid
+    for (char& c : k)
+        if (c == '-') c = '_';
+    return k;
+}
+
 void check_reader_options(const InputFormat& format, const ReaderOptions& options, const std::string& file_name) {
     for (const ReaderOptionInfo& o : kReaderOptions) {
         if (o.bit == kOptTimeUnit || (format.options & o.bit) != 0 || o.get(options).empty()) continue;
         std::string takers;
         for (const InputFormat& f : kFormats)
             if (f.options & o.bit) takers.append(takers.empty() ? "" : ", ").append(f.name);
-        throw std::invalid_argument(file_name + ": " + std::string(o.flag) + " applies to " + takers +
+        throw std::invalid_argument(file_name + ": " + option_spelling(options, o.flag) + " applies to " + takers +
                                     " files; this file is " + std::string(format.name));
     }
 }

@@ -439,7 +439,7 @@ std::size_t Hdf5Reader::read(std::span<Event> out) {
             const auto x = static_cast<std::uint32_t>(x_[k]);  // negative: huge, outside
             const auto y = static_cast<std::uint32_t>(y_[k]);
             if (x >= limit_w_ || y >= limit_h_) [[unlikely]] {
-                if (!options_.skip_invalid) fail_at(chunk_start_ + k, 0, outside_sensor_message(x_[k], y_[k], sensor_));
+                if (!options_.skip_invalid) fail_at(chunk_start_ + k, 0, outside_sensor_message(x_[k], y_[k], sensor_, options_.keyword_spelling));
                 skips_.skip(n);
                 continue;
             }

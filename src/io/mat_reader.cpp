@@ -349,16 +349,16 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
             else if (n == "y") role = 2;
             else if (n == "p" || n == "pol" || n == "polarity" || n == "on") role = 3;
             else if (n != "_" || col >= 4)
-                throw InputError(name_, "--mat-columns '" + spec + "': expected 4 names, each t, x, y, p or _");
+                throw InputError(name_, option_spelling(options_, "--mat-columns") + " '" + spec + "': expected 4 names, each t, x, y, p or _");
             if (role >= 0) {
-                if (seen[role] >= 0) throw InputError(name_, "--mat-columns '" + spec + "' names a column twice");
+                if (seen[role] >= 0) throw InputError(name_, option_spelling(options_, "--mat-columns") + " '" + spec + "' names a column twice");
                 seen[role] = col;
             }
             if (comma == std::string::npos) break;
             start = comma + 1;
         }
         if (col != 3 || std::find(std::begin(seen), std::end(seen), -1) != std::end(seen))
-            throw InputError(name_, "--mat-columns '" + spec + "' must name 4 columns and each of t, x, y, p once");
+            throw InputError(name_, option_spelling(options_, "--mat-columns") + " '" + spec + "' must name 4 columns and each of t, x, y, p once");
         std::copy(std::begin(seen), std::end(seen), col_);
     }
 
@@ -378,7 +378,7 @@ MatReader::MatReader(const std::string& path, ReaderOptions options) : name_(pat
             throw InputError(name_, candidates.empty()
                                         ? "no N x 4 real numeric variable to read events from (variables: " +
                                               (list.empty() ? std::string("none") : list) + ")"
-                                        : "several N x 4 numeric variables: " + list + "; pick one with --mat-var");
+                                        : "several N x 4 numeric variables: " + list + "; pick one with " + option_spelling(options_, "--mat-var"));
         }
     }
     // A damaged header can declare far more data than the file holds (fuzz_mat: 2^31 rows in
@@ -470,8 +470,8 @@ std::size_t MatReader::read(std::span<Event> out) {
                 if (!(std::fabs(v) < 9.2e18)) fail_row(i, fmt::format("time {} is out of range", values_[i]));
                 if (whole_us_ && v != std::floor(v))
                     fail_row(i, fmt::format("time {} is not a whole number of microseconds (the default unit of "
-                                            ".mat times); pass --time-unit s (or ms, ns) if the times are in another unit",
-                                            values_[i]));
+                                            ".mat times); pass {} s (or ms, ns) if the times are in another unit",
+                                            values_[i], option_spelling(options_, "--time-unit")));
                 e.t = std::llrint(v);
             } else {
                 const std::int64_t v = tint_[i];
@@ -492,7 +492,7 @@ std::size_t MatReader::read(std::span<Event> out) {
             e.y = static_cast<std::uint16_t>(y);
             e.p = p == 1 ? 1 : 0;
             if (e.x >= limit_w_ || e.y >= limit_h_) {
-                if (!options_.skip_invalid) fail_row(i, outside_sensor_message(e.x, e.y, sensor_));
+                if (!options_.skip_invalid) fail_row(i, outside_sensor_message(e.x, e.y, sensor_, options_.keyword_spelling));
                 skips_.skip(n);
                 ++next_;
                 continue;

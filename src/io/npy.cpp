@@ -343,9 +343,9 @@ NpyReader::NpyReader(InputFile file, ReaderOptions options)
             fail(pre, "unsupported dtype '" + printable(descr->s) +
                           "': a plain array must be integer or float (i1..i8, u1..u8, f4, f8)");
         if (shape->items.size() != 2 || shape->items[1].n != 4)
-            fail(pre, fmt::format("a plain '{}' array must have the shape (N, 4) (its columns named by --npy-columns), "
+            fail(pre, fmt::format("a plain '{}' array must have the shape (N, 4) (its columns named by {}), "
                                   "or be a structured array with fields t, x, y, p",
-                                  printable(descr->s)));
+                                  printable(descr->s), option_spelling(this->options(), "--npy-columns")));
         const std::string spec = this->options().npy_columns.empty() ? "t,x,y,p" : this->options().npy_columns;
         std::size_t start = 0;
         int col = 0;
@@ -354,9 +354,9 @@ NpyReader::NpyReader(InputFile file, ReaderOptions options)
             const std::string name = spec.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
             const int role = role_of(name);
             if (role == -1 || col >= 4)
-                fail(pre, "--npy-columns '" + spec + "' must name 4 columns, each t, x, y, p or _");
+                fail(pre, option_spelling(this->options(), "--npy-columns") + " '" + spec + "' must name 4 columns, each t, x, y, p or _");
             if (role >= 0) {
-                if (found[static_cast<std::size_t>(role)] >= 0) fail(pre, "--npy-columns '" + spec + "' names a column twice");
+                if (found[static_cast<std::size_t>(role)] >= 0) fail(pre, option_spelling(this->options(), "--npy-columns") + " '" + spec + "' names a column twice");
                 found[static_cast<std::size_t>(role)] = col;
                 fields_[role] = *type;
                 fields_[role].offset = static_cast<std::size_t>(col * type->size);
@@ -365,7 +365,7 @@ NpyReader::NpyReader(InputFile file, ReaderOptions options)
             start = comma + 1;
         }
         if (col != 3 || std::find(found.begin(), found.end(), -1) != found.end())
-            fail(pre, "--npy-columns '" + spec + "' must name 4 columns and each of t, x, y, p once");
+            fail(pre, option_spelling(this->options(), "--npy-columns") + " '" + spec + "' must name 4 columns and each of t, x, y, p once");
         itemsize_ = static_cast<std::size_t>(4 * type->size);
         declared_ = shape->items[0].n;
         fast_ = false;
@@ -550,9 +550,10 @@ bool NpyReader::decode_general() {
                         break;
                     }
                     if (whole && raw != static_cast<double>(static_cast<std::int64_t>(raw))) [[unlikely]] {
-                        mark(i, 0, fmt::format("time {} has a fraction, but --time-unit is {} (whole numbers: "
+                        mark(i, 0, fmt::format("time {} has a fraction, but {} is {} (whole numbers: "
                                                "a float time is seconds unless the unit is given)",
-                                               raw, this->options().csv_time_unit));
+                                               raw, option_spelling(this->options(), "--time-unit"),
+                                               this->options().csv_time_unit));
                         break;
                     }
                     out[i] = static_cast<std::int64_t>(v + (v >= 0 ? 0.5 : -0.5));  // nearest, halves away from zero

@@ -146,6 +146,7 @@ struct BagReader::Impl {
     detail::BagSource* src = nullptr;
     std::string topic;
     bool skip_invalid = false;
+    bool keyword_spelling = false;
     SkipLog* skips = nullptr;
     std::optional<SensorSize> sensor;
     std::uint32_t lw = kMaxSensorSide, lh = kMaxSensorSide;
@@ -191,7 +192,7 @@ struct BagReader::Impl {
 
     void push(std::int64_t t, std::uint32_t ex, std::uint32_t ey, bool on, std::uint64_t at) {
         if (ex >= lw || ey >= lh) [[unlikely]] {
-            if (!skip_invalid) fail(at, outside_sensor_message(ex, ey, sensor));
+            if (!skip_invalid) fail(at, outside_sensor_message(ex, ey, sensor, keyword_spelling));
             skips->skip(n);
             return;
         }
@@ -400,13 +401,15 @@ BagReader::BagReader(std::unique_ptr<detail::BagSource> source, ReaderOptions op
                                                           "EventPacket or dvs_msgs/EventArray); topics: {}",
                                                           topic_list(source_->topics())));
         if (count > 1)
-            throw InputError(source_->name(), fmt::format("the bag has {} event topics: choose one with --topic "
-                                                          "(topics: {})", count, topic_list(source_->topics())));
+            throw InputError(source_->name(), fmt::format("the bag has {} event topics: choose one with {} "
+                                                          "(topics: {})", count, option_spelling(options_, "--topic"),
+                                                          topic_list(source_->topics())));
     }
     topic_ = *chosen;
     impl_->src = source_.get();
     impl_->topic = topic_.name;
     impl_->skip_invalid = options_.skip_invalid;
+    impl_->keyword_spelling = options_.keyword_spelling;
     impl_->skips = &skips_;
     impl_->cdr = topic_.serialization != "ros1";
     source_->select(topic_.name);

@@ -106,7 +106,7 @@ std::size_t TextReader::read(std::span<Event> out) {
                                               : "no score, but the first event line had one (t x y p score)");
             if (r.e.t < last_t_) lines_.fail(b, e, backwards_message(last_t_, r.e.t));
             if (options_.sensor && !options_.sensor->contains(r.e)) {
-                if (!options_.skip_invalid) lines_.fail(b, e, outside_sensor_message(r.e.x, r.e.y, options_.sensor));
+                if (!options_.skip_invalid) lines_.fail(b, e, outside_sensor_message(r.e.x, r.e.y, options_.sensor, options_.keyword_spelling));
                 skips_.skip(n);
                 continue;
             }

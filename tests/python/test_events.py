@@ -364,3 +364,20 @@ def test_numpy_operations_keep_the_layout():
     for joined in (np.concatenate([events, events]), np.hstack([events, events]), np.append(events, events)):
         assert joined.dtype == evcorner.EVENT_DTYPE and joined.dtype.itemsize == 16
         assert evcorner._evcorner._address(joined) == joined.ctypes.data  # accepted in place, as every verb checks
+
+
+def test_reader_errors_name_python_keywords(tmp_path):
+    """Reader messages reaching Python name its keywords, not the CLI's flags."""
+    outside = tmp_path / "outside.txt"
+    outside.write_text("0.1 1 2 1\n0.2 300 5 1\n")
+    with pytest.raises(evcorner.InputError) as e:
+        evcorner.read(outside)
+    assert "set sensor=, or skip_invalid=True to skip" in str(e.value), str(e.value)
+    mixed = tmp_path / "mixed.csv"
+    mixed.write_text("100,1,1,1\n100.5,1,1,1\n")
+    with pytest.raises(evcorner.InputError) as e:
+        evcorner.read(mixed)
+    assert "(time_unit sets the unit)" in str(e.value) and "--" not in str(e.value), str(e.value)
+    with pytest.raises(ValueError) as e:
+        evcorner.read(mixed, aedat2_chip="DVS128")
+    assert "aedat2_chip applies to aedat2 files; this file is csv" in str(e.value), str(e.value)

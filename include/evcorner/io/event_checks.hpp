@@ -39,7 +39,9 @@ private:
 
 /// "event at x=.. y=.. lies outside the WxH sensor (set --size, or --skip-invalid ...)", or,
 /// with no sensor known, that the event does not fit 16-bit coordinates.
-std::string outside_sensor_message(std::int64_t x, std::int64_t y, const std::optional<SensorSize>& sensor);
+/// `keyword_spelling`: name the options as Python's keywords (ReaderOptions::keyword_spelling).
+std::string outside_sensor_message(std::int64_t x, std::int64_t y, const std::optional<SensorSize>& sensor,
+                                   bool keyword_spelling = false);
 /// "timestamp goes backwards (N us before the previous event)", exact for any two int64 times.
 std::string backwards_message(std::int64_t previous, std::int64_t t);
 

@@ -53,7 +53,14 @@ struct ReaderOptions {
     std::string mat_columns;
     /// ROS bags only: the topic to read (ros_bag.hpp). Empty: the bag's one event topic.
     std::string topic;
+    /// How messages name these options: as the CLI's flags ("--time-unit", "--size"), or
+    /// as Python's keywords ("time_unit=", "sensor=") for the Python package.
+    bool keyword_spelling = false;
 };
+
+/// The option `flag` ("--time-unit", "--size", "--skip-invalid", "--format", or a flag of
+/// io::reader_option_infos()) as `o`'s messages spell it: "--time-unit", or "time_unit".
+std::string option_spelling(const ReaderOptions& o, std::string_view flag);
 
 /// `count` consecutive events skipped as outside the sensor, which stood just before
 /// out[before] of the last read() (before == n: after the last one returned).
