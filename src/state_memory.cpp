@@ -81,4 +81,11 @@ void require_state_fits(std::string_view detector, SensorSize size, std::uint64_
                         " B per pixel); " + format_bytes(available) + " is available");
 }
 
+void require_memory_fits(std::string_view what, std::uint64_t need, std::string_view hint) {
+    const std::uint64_t available = available_memory_bytes();
+    if (available == 0 || need <= available) return;
+    throw StateTooLarge(std::string(what) + " needs " + format_bytes(need) + "; " + format_bytes(available) +
+                        " is available" + std::string(hint));
+}
+
 }  // namespace evcorner

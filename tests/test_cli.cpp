@@ -88,16 +88,31 @@ TEST_F(Cli, ReadsBinaryFormatsFromStandardInputToo) {
     EXPECT_EQ(from_stdin.out, from_file.out);
 }
 
-TEST_F(Cli, MalformedLineStopsWithFileLineAndKeepsWholeLines) {
+TEST_F(Cli, MalformedLineStopsWithFileLineAndLeavesNoOutputFiles) {
     std::string content = slurp(sample_);
     content += "52.1 12 oops 1\n52.2 1 1 1\n";
     const std::string in = write("bad.txt", content);
     const Result good = run("detect '" + sample_.string() + "' -q");
-    const Result r = run("detect bad.txt -o corners.txt --mask mask.txt");
+    write("mask.txt", "old mask\n");  // an existing output is left as it was
+    Result r = run("detect bad.txt -o corners.txt --mask mask.txt --summary-json s.json");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("bad.txt:30001:"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("'52.1 12 oops 1'"), std::string::npos) << r.err;
-    // Everything before the bad line was processed and written whole.
+    EXPECT_NE(r.err.find("corners.txt, mask.txt, s.json not written"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "corners.txt"));
+    EXPECT_FALSE(fs::exists(dir_ / "s.json"));
+    EXPECT_EQ(slurp(dir_ / "mask.txt"), "old mask\n");
+    for (const auto& entry : fs::directory_iterator(dir_))  // no temporary file left either
+        EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
+    // Standard output is a stream: it has had the corners of the events before the bad line, whole.
+    r = run("detect bad.txt");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.out, good.out);
+    EXPECT_NE(r.err.find("corners of the 30000 events before the error went to standard output"),
+              std::string::npos) << r.err;
+    // --allow-damaged: the result of the events before the bad line is the output.
+    r = run("detect bad.txt -o corners.txt --mask mask.txt --allow-damaged -q");
+    EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(slurp(dir_ / "corners.txt"), good.out);
     EXPECT_EQ(count_lines(slurp(dir_ / "mask.txt")), 30000u);
 }
@@ -113,7 +128,9 @@ TEST_F(Cli, CutShortBinaryFileIsAnErrorUnlessAllowed) {
     Result r = run("detect cut.npy -o corners.txt");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("cut.npy: byte "), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("28999 events before the error"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("corners.txt not written (--allow-damaged keeps the result of the 28999 events before"),
+              std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "corners.txt"));
 
     r = run("detect cut.npy -o corners.txt --allow-damaged --summary-json s.json");
     EXPECT_EQ(r.status, 0) << r.err;

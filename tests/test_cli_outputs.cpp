@@ -1,4 +1,4 @@
-// The evcorner tool's outputs as a user meets them (issue 15): never onto an input, never
+// The evcorner tool's outputs as a user meets them: never onto an input, never
 // two on one file or stream, complete or absent (atomic), every write checked, the
 // sensor size kept, the output format told or refused, JSON on standard output alone.
 
@@ -430,8 +430,9 @@ TEST_F(CliOutputs, ThePeakRateIsNeverBelowTheMean) {
 
 TEST_F(CliOutputs, Hdf5FailuresSayWhyWithoutHdf5sOwnStack) {
     Result r = run("convert " + sample() + " no-such-dir/x.h5");
-    EXPECT_EQ(r.status, 1);
-    EXPECT_NE(r.err.find("No such file or directory"), std::string::npos) << r.err;
+    EXPECT_EQ(r.status, 2);  // refused before reading, as every output is
+    EXPECT_NE(r.err.find("its folder no-such-dir does not exist (No such file or directory)"), std::string::npos)
+        << r.err;
     r = run("convert " + sample() + " " + full_device() + " --to hdf5");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("must be a regular file"), std::string::npos) << r.err;
@@ -462,6 +463,61 @@ TEST_F(CliOutputs, Hdf5AndMatioAreLoadedOnlyWhenUsed) {
     ASSERT_EQ(r.status, 0) << r.err;
     r = run("convert x.h5 back.txt");
     ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(count_lines(slurp(dir_ / "back.txt")), count_lines(slurp(sample_)));
+}
+
+TEST_F(CliOutputs, UnwritableOutputsAreRefusedBeforeTheInputIsRead) {
+    fs::create_directory(dir_ / "folder");
+    struct Case {
+        std::string command, option, why;
+    };
+    const std::vector<Case> cases = {
+        {"detect " + sample() + " -o c.txt --summary-json folder", "--summary-json folder", "is a folder"},
+        {"detect " + sample() + " -o missing/c.txt", "-o missing/c.txt", "its folder missing does not exist"},
+        {"detect " + sample() + " --mask c.txt/m.txt -o c.txt", "--mask c.txt/m.txt", "its folder c.txt does not exist"},
+        {"convert " + sample() + " folder", "OUTPUT folder", "is a folder"},
+        {"label " + sample() + " --json missing/l.json", "--json missing/l.json", "its folder missing does not exist"},
+        {"info " + sample() + " --json folder", "--json folder", "is a folder"},
+    };
+    for (const Case& c : cases) {
+        const Result r = sh("$E " + c.command);
+        EXPECT_EQ(r.status, 2) << c.command << "\n" << r.err;
+        EXPECT_NE(r.err.find("evcorner: error: " + c.option + ": " + c.why), std::string::npos) << c.command << "\n"
+                                                                                              << r.err;
+        EXPECT_EQ(files(), std::vector<std::string>{"folder"}) << c.command;  // c.txt not written either
+    }
+    // eval --report: a file where the folder should be.
+    write("report", "x");
+    const Result r = sh("$E eval " + sample() + " --report report");
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("--report report: exists and is not a folder"), std::string::npos) << r.err;
+    if (::geteuid() != 0) {  // root may write anywhere
+        fs::permissions(dir_ / "folder", fs::perms::owner_read | fs::perms::owner_exec);
+        const Result ro = sh("$E detect " + sample() + " -o folder/c.txt");
+        fs::permissions(dir_ / "folder", fs::perms::owner_all);
+        EXPECT_EQ(ro.status, 2) << ro.err;
+        EXPECT_NE(ro.err.find("cannot create files in folder"), std::string::npos) << ro.err;
+    }
+}
+
+TEST_F(CliOutputs, FormatsThatSeekBackAreRefusedOnPipesUpFront) {
+    ASSERT_EQ(::mkfifo((dir_ / "fifo").c_str(), 0600), 0);
+    // Nobody reads the FIFO: opening it would block, so a refusal must come before opening.
+    for (const std::string& cmd : {"detect " + sample() + " -o fifo --to npy", "convert " + sample() + " fifo --to npy",
+                                  "convert " + sample() + " fifo --to hdf5", "convert " + sample() + " fifo --to aedat4"}) {
+        const Result r = sh("timeout 20 $E " + cmd);
+        EXPECT_EQ(r.status, 2) << cmd << "\n" << r.err;
+        EXPECT_NE(r.err.find("output fifo is a pipe or socket, which cannot seek back"), std::string::npos)
+            << cmd << "\n" << r.err;
+    }
+    // Standard output to a pipe: the same, for npy and hdf5.
+    Result r = sh("$E convert " + sample() + " - --to npy | cat >/dev/null");
+    EXPECT_NE(r.err.find("output - (standard output) is a pipe or socket"), std::string::npos) << r.err;
+    // AEDAT 4.0 with a known size streams: a reader on the FIFO gets the whole file.
+    r = sh("$E convert " + sample() + " fifo --to aedat4 --size 240x180 -q & cat fifo > got.aedat4; wait $!");
+    EXPECT_EQ(r.status, 0) << r.err;
+    r = sh("$E convert got.aedat4 back.txt -q");
+    EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(count_lines(slurp(dir_ / "back.txt")), count_lines(slurp(sample_)));
 }
 

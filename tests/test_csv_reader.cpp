@@ -97,7 +97,8 @@ TEST(CsvReader, TimesTheRuleCannotReadAreErrors) {
         {"1,1,1,1\n1.0000000001,1,1,1\n", "s", 2, "more than 9 decimals of a second"},
         {"0.1,1,1,1\n0.2000000000001,1,1,1\n", "", 2, "more than 9 decimals of a second"},
         {"1,1,1,1\n2.5,1,1,1\n", "ns", 2, "fraction of a nanosecond"},
-        {"1,1,1,1\n1e20,1,1,1\n", "", 2, "expected a timestamp"},
+        {"1,1,1,1\n1e20,1,1,1\n", "s", 2, "at most 9e12 seconds"},
+        {"1,1,1,1\n2e-3,1,1,1\n", "", 2, "whose first time was an integer"},  // exponent notation: a float
         {"1,1,1,1\n9000000000000,1,1,1\n", "s", 2, "at most 9e12 seconds"},
     };
     for (const Case& c : cases) {

@@ -73,6 +73,26 @@ TEST_F(TextIo, DigitsPastTheNinthDecimalMustBeZeros) {
     EXPECT_EQ(ev[1].t, 9'000'000'000'000'000'000);
 }
 
+TEST_F(TextIo, ExponentNotationIsReadExactly) {
+    // The decimal the notation stands for, digit by digit (1.1e-6 is not 1.1 * 1e-6 in binary).
+    const auto ev = read(
+        "1e-6 1 2 1\n"
+        "1.5e-6 1 2 1\n"      // a half: up, as 0.0000015
+        "2.5E-1 1 2 1\n"
+        "4.3499039001e1 1 2 1\n"
+        "0.0051980787e4 1 2 0\n"
+        "+6e+1 1 2 0\n"
+        "8.999999999999999999999e12 1 2 0\n");
+    ASSERT_EQ(ev.size(), 7u);
+    EXPECT_EQ(ev[0].t, 1);
+    EXPECT_EQ(ev[1].t, 2);
+    EXPECT_EQ(ev[2].t, 250'000);
+    EXPECT_EQ(ev[3].t, 43'499'039);
+    EXPECT_EQ(ev[4].t, 51'980'787);
+    EXPECT_EQ(ev[5].t, 60'000'000);
+    EXPECT_EQ(ev[6].t, 9'000'000'000'000'000'000);
+}
+
 TEST_F(TextIo, ShortDecimals) {
     const auto ev = read("1.5 3 4 0\n2 5 6 1\n2.25 7 8 1\n3. 9 10 0\n");
     ASSERT_EQ(ev.size(), 4u);
@@ -127,7 +147,12 @@ TEST_F(TextIo, EachKindOfError) {
         {"0.1 1 2 1 7\n0.2 1 2 1\n", ":2:", "no score, but the first event line had one"},
         {"0.1 1 2 1\n0.2 1 2 1 7\n", ":2:", "a fifth column (a score)"},
         {"0.1 70000 2 1\n", ":1:", "x does not fit 16 bits"},
-        {"1e-3 1 2 1\n", ":1:", "expected a timestamp in seconds"},
+        {"1e20 1 2 1\n", ":1:", "timestamp too large (at most 9e12 seconds)"},
+        {"9.5e12 1 2 1\n", ":1:", "at most 9e12 seconds"},
+        {"1e-12 1 2 1\n", ":1:", "more than 9 decimals of a second"},
+        {"1e 1 2 1\n", ":1:", "expected a timestamp in seconds"},
+        {"1.2.3e1 1 2 1\n", ":1:", "expected a timestamp in seconds"},
+        {"e5 1 2 1\n", ":1:", "expected a timestamp in seconds"},
         {"0.0000014999 1 2 1\n", ":1:", "more than 9 decimals of a second"},
         {"9000000000000 1 2 1\n", ":1:", "at most 9e12 seconds"},
         {"\n\n0.1 1 2 1 junk\n", ":3:", "unexpected text"},

@@ -62,6 +62,7 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
+#include "evcorner/state_memory.hpp"
 #include "evcorner/parallel_detect.hpp"
 #include "bench_command_yardstick.hpp"
 #include "progress.hpp"
@@ -165,6 +166,9 @@ std::string compiler() {
 std::vector<Event> replay(const std::vector<Event>& file, std::uint64_t min_events, std::int64_t gap_us) {
     if (file.empty()) return {};
     const std::uint64_t reps = std::max<std::uint64_t>(1, (min_events + file.size() - 1) / file.size());
+    // The replayed stream and one flag per event (the detectors' output).
+    require_memory_fits(fmt::format("bench --min-events {}: {} replayed events", min_events, reps * file.size()),
+                        reps * file.size() * (sizeof(Event) + 1), " (lower --min-events)");
     const std::int64_t shift = file.back().t - file.front().t + 1 + gap_us;
     std::vector<Event> out;
     out.reserve(reps * file.size());
@@ -538,7 +542,10 @@ void run_bench(const BenchOptions& o) {
     {
         std::vector<io::NamedPath> inputs;
         for (const auto& in : o.inputs) inputs.push_back({"FILE", in});
-        if (!o.json.empty()) io::check_output_paths(inputs, {{"--json", o.json}});
+        if (!o.json.empty()) {
+            io::check_output_paths(inputs, {{"--json", o.json}});
+            io::check_outputs_creatable({{"--json", o.json}});
+        }
     }
     // With the JSON on standard output, the human-readable report goes to standard error.
     std::FILE* const out = o.json == "-" ? stderr : stdout;

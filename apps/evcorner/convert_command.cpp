@@ -57,6 +57,7 @@ SensorSize fallback_size(int max_x, int max_y, const std::string& to, const std:
 void run_convert(const ConvertOptions& o) {
     // Before anything is opened: an output onto the input, and the output format.
     io::check_output_paths({{"INPUT", o.input}}, {{"OUTPUT", o.output}});
+    io::check_outputs_creatable({{"OUTPUT", o.output}});
     const std::string to = io::resolve_output_format(o.output, o.to);
     io::ReaderOptions ropts;
     ropts.skip_invalid = o.skip_invalid;
@@ -71,6 +72,7 @@ void run_convert(const ConvertOptions& o) {
     // The input's size (--size included) goes into formats that record one.
     const std::optional<SensorSize> sensor = reader->sensor();
     const auto writer = io::open_event_writer(o.output, to, sensor);
+    const bool output_is_file = io::output_is_file(o.output);
     Progress progress(!o.quiet && !o.no_progress, reader->bytes_total());
     std::vector<Event> buf(kBatch);
     std::uint64_t events = 0;
@@ -96,8 +98,14 @@ void run_convert(const ConvertOptions& o) {
         }
     } catch (const InputError& e) {
         if (!o.allow_damaged) {
-            finish();
-            fmt::print(stderr, "evcorner: the {} events before the error are written to {}\n", events, writer->name());
+            // The writer is left unclosed: a file output is removed, a stream keeps what it got.
+            progress.finish();
+            if (output_is_file)
+                fmt::print(stderr,
+                           "evcorner: {} is not written (--allow-damaged keeps the {} events before the error)\n",
+                           o.output, events);
+            else
+                fmt::print(stderr, "evcorner: the {} events before the error went to {}\n", events, writer->name());
             throw;
         }
         progress.finish();

@@ -10,6 +10,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -116,6 +117,7 @@ void run_detect(DetectOptions& o) {
     // Before anything is opened: outputs onto the input or onto each other.
     io::check_output_paths({{"INPUT", o.files.input}},
                            {{"-o", o.files.output}, {"--mask", o.files.mask}, {"--summary-json", o.summary_json}});
+    io::check_outputs_creatable({{"-o", o.files.output}, {"--mask", o.files.mask}, {"--summary-json", o.summary_json}});
     io::ReaderOptions& ropts = o.files.reader;
     ropts.skip_invalid = o.skip_invalid;
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);  // validated by CLI11
@@ -143,12 +145,17 @@ void run_detect(DetectOptions& o) {
     try {
         t = pipeline::detect_file(o.files, o.run, on_batch);
     } catch (const InputError&) {
+        // Output files are left absent; streams (standard output, FIFOs) keep what they got.
         if (progress) progress->finish();
-        if (last.events > 0)
-            fmt::print(stderr,
-                       "evcorner: the {} events before the error were processed; their {} "
-                       "corners are written\n",
-                       last.events, last.corners);
+        std::string files;
+        for (const std::string* p : {&o.files.output, &o.files.mask, &o.summary_json})
+            if (io::output_is_file(*p)) files += (files.empty() ? "" : ", ") + *p;
+        if (!files.empty())
+            fmt::print(stderr, "evcorner: {} not written (--allow-damaged keeps the result of the {} events before "
+                               "the error)\n", files, last.events);
+        if (!o.files.output.empty() && !io::output_is_file(o.files.output) && last.events > 0)
+            fmt::print(stderr, "evcorner: the {} corners of the {} events before the error went to {}\n",
+                       last.corners, last.events, o.files.output == "-" ? "standard output" : o.files.output);
         throw;
     }
     if (progress) progress->finish();
@@ -180,7 +187,8 @@ void add_detect_command(CLI::App& app) {
     cmd->add_option("INPUT", o->files.input, "Event file, or - for standard input")->required();
     o->run.detector.name = "efast";
     add_detector_option(*cmd, o->run.detector.name,
-                        "Detector to run (its parameters: the options below, or -p KEY=VALUE):" + detectors_help());
+                        "Detector to run (its parameters: \"Detector parameters\" below, or -p KEY=VALUE):" +
+                            detectors_help());
     cmd->add_option("-o,--output", o->files.output,
                     "Corner events (- = standard output, as 't x y p' lines); the format follows the "
                     "extension (.txt, .csv, .npy, .aedat4, .h5, .hdf5; others are refused; none = text). "
@@ -223,6 +231,18 @@ void add_detect_command(CLI::App& app) {
                   "Skip events outside the sensor (counted in the summary) instead of failing");
     cmd->add_flag("-q,--quiet", o->quiet, "No summary and no progress bar");
     cmd->add_flag("--no-progress", o->no_progress, "No progress bar (it shows only on a terminal)");
+    static constexpr struct {
+        const char* group;
+        const char* options;
+    } kGroups[] = {{"Input",
+                    "--format --csv-columns --time-unit --chip --topic --npy-columns --mat-var --mat-columns --size "
+                    "--skip-invalid --allow-damaged"},
+                   {"Output", "--output --to --mask --summary-json --with-score --quiet --no-progress"},
+                   {"Detector", "--detector --threads"}};
+    for (const auto& g : kGroups) {
+        std::istringstream names(g.options);
+        for (std::string name; names >> name;) cmd->get_option(name)->group(g.group);
+    }
     cmd->footer(
         "Examples:\n"
         "  evcorner detect events.txt -o corners.txt\n"

@@ -38,9 +38,9 @@ std::string detectors_help() {
         if (!extras.empty()) extras += "; ";
         extras += d.local() ? (d.split == Split::by_polarity ? "--threads: split by polarity" : "--threads: split by rows")
                             : "one thread only";
-        s += fmt::format("\n  {:<14}   {}", "", extras);
-        for (const ParamInfo& p : d.params)
-            s += fmt::format("\n  {:<14}   --{} {} [default {}]", "", p.key, range_text(p), format_param_value(p.default_value));
+        std::string keys;
+        for (const ParamInfo& p : d.params) keys += (keys.empty() ? "" : " ") + ("--" + std::string(p.key));
+        s += fmt::format("\n  {:<14}   {}{}", "", extras, keys.empty() ? "" : "; parameters " + keys);
     }
     return s;
 }
@@ -126,9 +126,9 @@ std::vector<std::string> parse_detector_list(const std::string& list) {
 
 std::string all_detectors_list() { return detector_names(","); }
 
-void add_nms_options(CLI::App& cmd, bool& on, NmsParams& params, std::string& rule) {
+void add_nms_options(CLI::App& cmd, bool& on, NmsParams& params, std::string& rule, CLI::Option* enabler) {
     const char* group = "Non-maximum suppression";
-    cmd.add_flag("--nms", on,
+    CLI::Option* nms = cmd.add_flag("--nms", on,
                  "Asynchronous non-maximum suppression after the detector (docs/nms.md): a corner is dropped "
                  "when an earlier corner of its polarity within --nms-radius px and --nms-time us has an equal or "
                  "larger score (rule window) or an equal or larger decayed score (rule decay); decided at the "
@@ -146,6 +146,14 @@ void add_nms_options(CLI::App& cmd, bool& on, NmsParams& params, std::string& ru
         ->capture_default_str()
         ->check(CLI::Range(std::int64_t{1}, NmsParams::kMaxTimeUs))
         ->group(group);
+    // The --nms-* options change nothing unless NMS runs.
+    const std::string needed = enabler ? "--nms or " + enabler->get_name() : std::string("--nms");
+    cmd.parse_complete_callback([&cmd, nms, enabler, needed] {
+        if (nms->count() > 0 || (enabler && enabler->count() > 0)) return;
+        for (const char* name : {"--nms-rule", "--nms-radius", "--nms-time"})
+            if (cmd.count(name) > 0)
+                throw CLI::ValidationError(std::string(name) + ": does nothing without " + needed);
+    });
 }
 
 }  // namespace evcorner::cli

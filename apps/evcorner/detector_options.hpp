@@ -31,6 +31,8 @@ std::string all_detectors_list();
 
 /// --nms (sets `on`), --nms-rule window|decay, --nms-radius PX, --nms-time US (nms.hpp), in
 /// the "Non-maximum suppression" group.
-void add_nms_options(CLI::App& cmd, bool& on, NmsParams& params, std::string& rule);
+/// `enabler`: another flag that turns NMS on too (eval's --compare-nms); the --nms-*
+/// options are a usage error without --nms or it.
+void add_nms_options(CLI::App& cmd, bool& on, NmsParams& params, std::string& rule, CLI::Option* enabler = nullptr);
 
 }  // namespace evcorner::cli

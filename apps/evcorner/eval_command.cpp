@@ -682,6 +682,7 @@ void run_eval(EvalOptions& o) {
                                  "truth_speed.csv", "pr_curve.csv"})
             outputs.push_back({"--report", (fs::path(o.report) / name).string()});
         io::check_output_paths(inputs, outputs);
+        io::check_output_folder({"--report", o.report});
         fs::create_directories(o.report);
         if (!o.no_figures) fs::create_directories(fig_dir = fs::path(o.report) / "figures");
     }
@@ -1072,10 +1073,11 @@ void add_eval_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::IsMember({"linear", "nearest"}))
         ->group(tg);
-    add_nms_options(*cmd, o->nms, o->nms_params, o->nms_rule);
-    cmd->add_flag("--compare-nms", o->compare_nms,
-                  "Run every detector twice: without NMS and with it (as NAME+nms), with the --nms-* options")
-        ->group("Non-maximum suppression");
+    CLI::Option* compare_nms =
+        cmd->add_flag("--compare-nms", o->compare_nms,
+                      "Run every detector twice: without NMS and with it (as NAME+nms), with the --nms-* options")
+            ->group("Non-maximum suppression");
+    add_nms_options(*cmd, o->nms, o->nms_params, o->nms_rule, compare_nms);
     cmd->add_option("--speed-bins", o->speed_edges,
                     "Image-speed bin edges, px/s, from 0, increasing [default: 0,50,100,200,400,700]")
         ->delimiter(',')

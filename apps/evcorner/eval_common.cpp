@@ -99,10 +99,16 @@ std::int64_t parse_time_option(const std::string& text, std::int64_t first_us, s
     }
     if (used == 0 || used != text.size() - (rel ? 1 : 0) || !std::isfinite(v) || v < 0)
         throw std::invalid_argument("bad time '" + text + "' (seconds, '+S' after the start or '-S' before the end)");
+    // Times are integer microseconds: 9.2e12 s (292 000 years) is the most they hold.
+    constexpr double kMaxSeconds = 9.2e12;
+    if (v > kMaxSeconds)
+        throw std::invalid_argument("time '" + text + "' is out of range (at most 9.2e12 s: times are integer microseconds)");
     const auto us = static_cast<std::int64_t>(std::llround(v * 1e6));
-    if (text[0] == '+') return first_us + us;
-    if (text[0] == '-') return last_us - us;
-    return us;
+    std::int64_t t = us;
+    if ((text[0] == '+' && __builtin_add_overflow(first_us, us, &t)) ||
+        (text[0] == '-' && __builtin_sub_overflow(last_us, us, &t)))
+        throw std::invalid_argument("time '" + text + "' is out of range of the stream's clock");
+    return t;
 }
 
 }  // namespace evcorner::cli

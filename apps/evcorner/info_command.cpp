@@ -16,6 +16,7 @@
 #include "evcorner/io/aedat2_reader.hpp"
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
+#include "evcorner/io/formats.hpp"
 #include "evcorner/io/output_paths.hpp"
 #include "evcorner/io/ros_bag.hpp"
 #include "progress.hpp"
@@ -106,7 +107,10 @@ void add_bag_topics(nlohmann::json& j, const io::BagReader& bag) {
 }
 
 void run_info(const InfoOptions& o) {
-    if (!o.json.empty()) io::check_output_paths({{"INPUT", o.input}}, {{"--json", o.json}});
+    if (!o.json.empty()) {
+        io::check_output_paths({{"INPUT", o.input}}, {{"--json", o.json}});
+        io::check_outputs_creatable({{"--json", o.json}});
+    }
     io::ReaderOptions ropts;
     ropts.skip_invalid = o.skip_invalid;
     ropts.fallback_sensor = std::nullopt;  // describe any file, whatever its size
@@ -200,14 +204,12 @@ void run_info(const InfoOptions& o) {
 
 void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit,
                        std::string& chip) {
-    cmd.add_option("--format", format,
-                   "Input format: auto (from the content), " + std::string(io::kInputFormats))
+    cmd.add_option("--format", format, "Input format: auto (from the content), " + io::input_format_names())
         ->capture_default_str()
         ->check([](const std::string& name) {
-            // The names open_event_reader() takes, and its aliases.
-            std::string known = ", auto, text, aedat, h5, " + std::string(io::kInputFormats) + ",";
-            if (known.find(", " + name + ",") != std::string::npos) return std::string();
-            return "unknown input format '" + name + "' (known: auto, " + std::string(io::kInputFormats) + ")";
+            // The names of the format table, and their aliases.
+            if (name == "auto" || io::find_input_format(name)) return std::string();
+            return "unknown input format '" + name + "' (known: auto, " + io::input_format_names() + ")";
         });
     cmd.add_option("--csv-columns", csv_columns,
                    "CSV column order, e.g. x,y,p,t ('_' skips a column) [default: the header row, else t,x,y,p]");

@@ -37,6 +37,7 @@ void run_label(LabelOptions& o) {
     if (o.output == "-" && o.json == "-")
         throw std::invalid_argument("-o - and --json - would both write to standard output; send one to a file");
     io::check_output_paths({{"CORNERS", o.input}}, {{"-o", o.output}, {"--json", o.json}});
+    io::check_outputs_creatable({{"-o", o.output}, {"--json", o.json}});
     // Progress bars on standard error while reading and while labelling (terminal only).
     const LoadedEvents corners = load_events(o.input, o.in, !o.no_progress);
     const auto t0 = std::chrono::steady_clock::now();

@@ -63,6 +63,36 @@ std::string unknown_command(CLI::App& app, const std::string& word) {
     return msg + " (commands: " + list + ")";
 }
 
+// "did you mean '--nms-radius'?" for the first long option of the command line that the
+// command named (or the top level) does not have, when one of its options is close to it;
+// empty otherwise.
+std::string option_suggestion(CLI::App& app, int argc, char** argv) {
+    CLI::App* cmd = &app;
+    for (CLI::App* sub : app.get_subcommands())  // the command that was parsed
+        cmd = sub;
+    std::vector<std::string> names;
+    for (const CLI::Option* opt : cmd->get_options())
+        for (const std::string& n : opt->get_lnames()) names.push_back("--" + n);
+    for (int i = 1; i < argc; ++i) {
+        std::string word = argv[i];
+        if (word == "--") break;
+        if (word.size() < 3 || word.compare(0, 2, "--") != 0) continue;
+        if (const auto eq = word.find('='); eq != std::string::npos) word.resize(eq);
+        if (std::find(names.begin(), names.end(), word) != names.end()) continue;
+        std::string best;
+        std::size_t best_d = std::string::npos;
+        for (const auto& n : names)
+            if (const std::size_t d = edit_distance(word, n); d < best_d) {
+                best_d = d;
+                best = n;
+            }
+        if (best_d <= 2 && 2 * best_d < std::max(word.size(), best.size()) - 2)
+            return "did you mean '" + best + "'? (" + cmd->get_name() + " has no option '" + word + "')";
+        return {};
+    }
+    return {};
+}
+
 // Help and version text, through stdio so that a failed write keeps its errno.
 int print_help(const CLI::App& app, const CLI::Error& e) {
     std::ostringstream text;
@@ -133,7 +163,9 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return print_help(app, e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
+        std::string msg = e.what();
+        if (const std::string hint = option_suggestion(app, argc, argv); !hint.empty()) msg += "; " + hint;
+        std::fprintf(stderr, "evcorner: error: %s\nRun with --help for more information.\n", msg.c_str());
         return finish_stdout(2);
     } catch (const std::invalid_argument& e) {
         // A parameter out of range, caught when the detector or writer is built, or

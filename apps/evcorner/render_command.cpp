@@ -19,6 +19,7 @@
 #include <span>
 #include <filesystem>
 #include <fmt/format.h>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -35,6 +36,7 @@
 #include "evcorner/io/output_paths.hpp"
 #include "evcorner/render/figures.hpp"
 #include "evcorner/render/frame.hpp"
+#include "evcorner/state_memory.hpp"
 #include "progress.hpp"
 
 namespace evcorner::cli {
@@ -195,11 +197,34 @@ struct Kept {
     bool events_trimmed_before_at = false;  // some event <= at was dropped as too old
 };
 
+// The figure's images (the sensor-sized drawing, its upscaled copy and the framed figure),
+// 3 bytes a pixel, before anything is allocated: --size and --scale decide them.
+void require_figure_fits(const RenderOptions& o, SensorSize size) {
+    const auto w = static_cast<std::uint64_t>(size.width), h = static_cast<std::uint64_t>(size.height);
+    const auto s = static_cast<std::uint64_t>(o.scale);
+    std::uint64_t body_w = w * s, body_h = h * s, need = 0;
+    if (o.kind == "sae" || o.kind == "corners") {
+        need = w * h * 3 + 2 * body_w * body_h * 3;
+    } else {
+        render::SpaceTimeStyle style;
+        style.scale = o.scale;
+        style.time_height = o.time_height;
+        const render::SpaceTimeLayout layout = render::space_time_layout(size, style);
+        body_w = static_cast<std::uint64_t>(layout.width);
+        body_h = static_cast<std::uint64_t>(layout.height);
+        need = 2 * body_w * body_h * 3;
+    }
+    require_memory_fits(fmt::format("render -k {}: a {}x{} figure ({}x{} sensor, --scale {})", o.kind, body_w, body_h,
+                                    size.width, size.height, o.scale),
+                        need, " (lower --scale, or --time-height for space-time figures)");
+}
+
 // Reads the input batch by batch, detects, keeps what `need` asks for.
 Kept stream_input(const RenderOptions& o, const Need& need, bool detect_here) {
     const auto reader = open_events(o.input, o.in);
     Kept k;
     k.size = sensor_of(*reader);
+    require_figure_fits(o, k.size);
     std::optional<AnyDetector> detector;
     if (detect_here) detector = make_detector(DetectorConfig{o.detector, o.detector_params}, k.size, "--");
     // --at known from the first event on (seconds, "+S"), or only at the end (absent, "-S").
@@ -318,6 +343,7 @@ void run_render(RenderOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
     check_output_name(o.output);
     io::check_output_paths({{"INPUT", o.input}, {"--corners", o.corners_file}}, {{"-o", o.output}});
+    io::check_outputs_creatable({{"-o", o.output}});
     if (!o.at.empty()) (void)parse_time_option(o.at, 0, 0);  // its syntax, before reading anything
     const Need need = need_for(o);
     const bool from_file = !o.corners_file.empty();
@@ -468,10 +494,10 @@ void add_render_command(CLI::App& app) {
         ->check([](const std::string& s) {
             try {
                 const double v = std::stod(s);
-                if (std::isfinite(v) && v > 0) return std::string();
+                if (std::isfinite(v) && v > 0 && v <= 1e9) return std::string();
             } catch (const std::exception&) {
             }
-            return "must be a number of milliseconds > 0, not '" + s + "'";
+            return "must be a number of milliseconds > 0 and at most 1e9 (11.6 days), not '" + s + "'";
         });
     cmd->add_option("--scale", o->scale, "Image pixels per sensor pixel")->capture_default_str()->check(CLI::Range(1, 16));
     cmd->add_option("--polarity", o->polarity, "sae: polarity shown, 1 = ON, 0 = OFF")
@@ -489,7 +515,29 @@ void add_render_command(CLI::App& app) {
         "  evcorner render events.txt -k corners -o fig6.png --at +0.04\n"
         "  evcorner render events.txt -k labels -d harris -o fig5b.png\n"
         "  evcorner render events.txt -k sae --polarity 0 --window 30 -o sae.png");
-    cmd->callback([o] { run_render(*o); });
+    cmd->callback([o, cmd] {
+        // An option that changes nothing in the figure asked for is a usage error.
+        auto only_for = [&](const char* option, std::initializer_list<const char*> kinds) {
+            if (cmd->count(option) == 0) return;
+            std::string list;
+            for (const char* k : kinds) {
+                if (o->kind == k) return;
+                list += (list.empty() ? "-k " : " or ") + std::string(k);
+            }
+            throw std::invalid_argument(std::string(option) + " applies to " + list + " only (this is -k " + o->kind +
+                                        ")");
+        };
+        only_for("--polarity", {"sae"});
+        only_for("--detector", {"corners", "space-time", "labels"});
+        if (cmd->count("--detector") && cmd->count("--corners"))
+            throw std::invalid_argument("--detector with --corners: the corner events come from the file, nothing is "
+                                        "detected");
+        only_for("--time-height", {"space-time", "labels"});
+        for (const char* ft : {"--ft-inner", "--ft-outer", "--ft-min-inner", "--ft-max-outer-ratio", "--ft-max-duration",
+                               "--ft-max-length", "--ft-per-polarity", "--ft-overlap"})
+            only_for(ft, {"labels"});
+        run_render(*o);
+    });
 }
 
 }  // namespace evcorner::cli

@@ -185,6 +185,7 @@ void run_simulate(const SimulateOptions& o) {
     }
     if (o.output.empty()) throw std::invalid_argument("-o: the events' output is required");
     io::check_output_paths({{"SCENE", o.scene}}, {{"-o", o.output}, {"--truth", o.truth}});
+    io::check_outputs_creatable({{"-o", o.output}, {"--truth", o.truth}});
     const sim::Scene scene = o.preset.empty() ? sim::load_scene_file(o.scene) : sim::parse_scene(text, "preset " + o.preset);
     const RunTotals t = run_scene(scene, o.output, o.to, o.truth, o.truth_every_us, !o.quiet && !o.no_progress);
     if (!o.quiet) print_summary(o.preset.empty() ? o.scene : "preset " + o.preset, scene, t);

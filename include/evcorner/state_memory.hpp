@@ -27,7 +27,13 @@ std::uint64_t available_memory_bytes() noexcept;
 std::string format_bytes(std::uint64_t bytes);
 
 /// Throws StateTooLarge when `need` bytes of `detector`'s state for `size` exceed
-/// `available` (0: unknown, never refused).
+/// `available` (0: unknown, never refused). What every other allocation a user's number
+/// decides (an image's size, a replay's length, a simulated sensor) is checked with too:
 void require_state_fits(std::string_view detector, SensorSize size, std::uint64_t need, std::uint64_t available);
+
+/// Throws StateTooLarge, reading "<what> needs 24.6 GB; 21.3 GB is available<hint>", when
+/// `need` bytes exceed available_memory_bytes() (unknown: never refused). `hint` tells
+/// the user what to lower, e.g. " (lower --scale)".
+void require_memory_fits(std::string_view what, std::uint64_t need, std::string_view hint = {});
 
 }  // namespace evcorner

@@ -125,7 +125,9 @@ def detect_file(input, output=None, detector="efast", mask=None, format="auto", 
     """`evcorner detect` as a function: the library's pipeline from the file `input` to the
     corner file `output` (None: none) and the mask file `mask` (one 0/1 line per event).
     `reader`: a dict of reader options (READER_OPTIONS). Returns the summary as the CLI's
-    --summary-json writes it (input, detector, width, height, events, corners, ...)."""
+    --summary-json writes it (input, detector, width, height, events, corners, ...).
+    Damaged input raises, and then leaves no output file (allow_damaged=True: the outputs
+    of the events before the damage, and the summary's 'damaged' names it)."""
     return _evcorner.detect_file(
         _input_path(input),
         "" if output is None else os.fspath(output),

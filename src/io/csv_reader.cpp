@@ -91,7 +91,10 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
         while (fe > f && is_space(fe[-1])) --fe;
         const Field kind = columns_[col];
         if (kind == kT) {
-            const bool has_point = std::memchr(f, '.', static_cast<std::size_t>(fe - f)) != nullptr;
+            // A float: a decimal point, or exponent notation ("1e-3").
+            const auto n = static_cast<std::size_t>(fe - f);
+            const bool has_point = std::memchr(f, '.', n) != nullptr || std::memchr(f, 'e', n) != nullptr ||
+                                   std::memchr(f, 'E', n) != nullptr;
             TimeUnit unit = time_unit_;
             bool whole = unit == TimeUnit::us;
             if (!unit_given_) {

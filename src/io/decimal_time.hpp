@@ -9,6 +9,7 @@
 // - with `whole_only`, any nonzero fraction (a time column in microseconds holds whole
 //   numbers: a fraction means the values are in another unit);
 // - a value of |t| >= 9e12 seconds (about 285 000 years: microseconds far from int64's end).
+// Exponent notation ("1.5e-3", "1e20") is read exactly too, as the decimal it stands for.
 
 #include <cstdint>
 
@@ -31,7 +32,90 @@ struct DecimalTime {
 };
 
 /// Parses [b, e) (no surrounding spaces) as an optionally signed decimal in `unit`.
+inline DecimalTime parse_decimal_time(const char* b, const char* e, TimeUnit unit, bool whole_only) noexcept;
+
+/// "1.5e-3", "1e20": the mantissa's decimal point moved by the exponent, exactly, then
+/// parsed as above (has_point set: exponent notation is a float). False when [b, e) has
+/// no exponent (then `out` is untouched).
+inline bool parse_exponent_time(const char* b, const char* e, TimeUnit unit, bool whole_only, DecimalTime& out) noexcept {
+    const char* x = b;
+    while (x < e && *x != 'e' && *x != 'E') ++x;
+    if (x == e) return false;
+    const auto is_digit = [](char c) { return static_cast<unsigned char>(c - '0') < 10; };
+    out = {0, true, kNotATimestamp};
+    const char* m = b;
+    const bool negative = m < x && *m == '-';
+    if (m < x && (*m == '-' || *m == '+')) ++m;
+    // The mantissa's digits without its point, and how many come before the point.
+    char digits[64];
+    int n = 0, before = 0, seen = 0;
+    bool point = false, nonzero = false;
+    for (const char* c = m; c < x; ++c) {
+        if (*c == '.' && !point) {
+            point = true;
+            continue;
+        }
+        if (!is_digit(*c)) return true;
+        ++seen;
+        if (n == 0 && *c == '0') {  // leading zeros carry no digit
+            if (point) --before;
+            continue;
+        }
+        if (n == static_cast<int>(sizeof digits)) {
+            out = {0, true, "a timestamp of more than 64 significant digits"};
+            return true;
+        }
+        nonzero |= *c != '0';
+        digits[n++] = *c;
+        if (!point) ++before;
+    }
+    if (seen == 0) return true;
+    const char* y = x + 1;
+    bool exp_negative = false;
+    if (y < e && (*y == '-' || *y == '+')) exp_negative = *y++ == '-';
+    if (y == e) return true;
+    long exponent = 0;
+    for (; y < e; ++y) {
+        if (!is_digit(*y)) return true;
+        if (exponent < 100000) exponent = exponent * 10 + (*y - '0');
+    }
+    if (exp_negative) exponent = -exponent;
+    if (!nonzero) {
+        out = {0, true, nullptr};
+        return true;
+    }
+    const long place = before + exponent;  // digits before the point, once moved
+    if (place > 40) {
+        out = {0, true, "timestamp too large (at most 9e12 seconds)"};
+        return true;
+    }
+    if (place < -40) {
+        out = {0, true, "a time given to a fraction of a nanosecond (more than 9 decimals of a second)"};
+        return true;
+    }
+    // The plain decimal: sign, digits with the point at `place`, zeros filled in.
+    char plain[160];
+    int k = 0;
+    if (negative) plain[k++] = '-';
+    if (place <= 0) {
+        plain[k++] = '0';
+        plain[k++] = '.';
+        for (long i = 0; i < -place; ++i) plain[k++] = '0';
+        for (int i = 0; i < n; ++i) plain[k++] = digits[i];
+    } else {
+        for (long i = 0; i < place; ++i) plain[k++] = i < n ? digits[i] : '0';
+        if (place < n) {
+            plain[k++] = '.';
+            for (int i = static_cast<int>(place); i < n; ++i) plain[k++] = digits[i];
+        }
+    }
+    out = parse_decimal_time(plain, plain + k, unit, whole_only);
+    out.has_point = true;
+    return true;
+}
+
 inline DecimalTime parse_decimal_time(const char* b, const char* e, TimeUnit unit, bool whole_only) noexcept {
+    if (DecimalTime x; parse_exponent_time(b, e, unit, whole_only, x)) return x;
     DecimalTime r;
     const auto is_digit = [](char c) { return static_cast<unsigned char>(c - '0') < 10; };
     bool negative = false;

@@ -1,5 +1,8 @@
 #include "evcorner/io/event_writer.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <stdexcept>
 
 #include "evcorner/error.hpp"
@@ -78,9 +81,33 @@ void EventWriter::write(std::span<const Event> /*events*/, std::span<const doubl
     throw std::logic_error("EventWriter: this writer was not opened with scores");
 }
 
+namespace {
+
+// Refuses, before anything is opened or read, an output that is a pipe or socket (a FIFO
+// path, or standard output to one) for a format that completes its file by seeking back:
+// it would stream every event and then fail, leaving its reader a header with no count.
+void refuse_stream_output(const std::string& path, std::string_view format, std::string_view why) {
+    struct stat st {};
+    bool stream = false;
+    if (path == "-")
+        stream = ::fstat(STDOUT_FILENO, &st) == 0 && !S_ISREG(st.st_mode) && ::lseek(STDOUT_FILENO, 0, SEEK_CUR) < 0;
+    else
+        stream = ::stat(path.c_str(), &st) == 0 && (S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode));
+    if (!stream) return;
+    throw std::invalid_argument("output " + (path == "-" ? std::string("- (standard output)") : path) +
+                                " is a pipe or socket, which cannot seek back: " + std::string(why) + "; write " +
+                                std::string(format) + " to a regular file, or stream ecd-text or csv");
+}
+
+}  // namespace
+
 std::unique_ptr<EventWriter> open_event_writer(const std::string& path, std::string_view format,
                                                std::optional<SensorSize> sensor, bool with_score) {
     const std::string f = resolve_output_format(path, format);
+    if (f == "npy") refuse_stream_output(path, f, "a .npy header holds the event count, written last");
+    if (f == "hdf5") refuse_stream_output(path, f, "HDF5 seeks back to complete its file");
+    if (f == "aedat4" && !sensor)
+        refuse_stream_output(path, f, "with no sensor size given, AEDAT 4.0 records the size at the end");
     if (f == "ecd-text") return std::make_unique<TextEventWriter>(path, with_score);
     if (f == "csv") return std::make_unique<CsvWriter>(path, with_score);
     if (f == "npy") return std::make_unique<NpyWriter>(path, with_score);

@@ -280,8 +280,10 @@ DetectSummary run_detect(io::EventReader& reader, const DetectOptions& o, std::s
                 else
                     run.single(*single);
             } catch (const InputError& e) {
-                close_sinks();  // the outputs of the events before the error are complete
+                // Without allow_damaged the sinks stay unclosed: a file output is then left
+                // absent (writers remove an unfinished file), never a partial result under its name.
                 if (!o.allow_damaged) throw;
+                close_sinks();  // the outputs of the events before the damage are the result
                 s.damaged = e.what();
             }
         };
@@ -309,6 +311,7 @@ DetectSummary detect_file(const DetectFiles& f, const DetectOptions& o, const Pr
     const auto wall_start = Clock::now();
     // Before anything is opened: outputs onto the input or onto each other, the options.
     io::check_output_paths({{"input", f.input}}, {{"output", f.output}, {"mask", f.mask}});
+    io::check_outputs_creatable({{"output", f.output}, {"mask", f.mask}});
     check_detect_options(o);
     const std::string to = f.output.empty() ? std::string() : io::resolve_output_format(f.output, f.to);
     if (o.with_score && to == "aedat4")

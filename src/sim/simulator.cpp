@@ -1,5 +1,7 @@
 #include "evcorner/sim/simulator.hpp"
 
+#include "evcorner/state_memory.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <climits>
@@ -143,6 +145,10 @@ Simulator::Simulator(Scene scene)
     if (std::max(stride_, words_ * 64) * static_cast<std::size_t>(h_) > UINT32_MAX)
         throw std::length_error("simulate: a " + std::to_string(w_) + "x" + std::to_string(h_) +
                                 " sensor is too large for the simulator (at most about 4.29e9 pixels)");
+    // Per pixel: the background, two intensity planes (double) and the marks' bits.
+    require_memory_fits("simulate: a " + std::to_string(w_) + "x" + std::to_string(h_) + " sensor",
+                        static_cast<std::uint64_t>(stride_) * static_cast<std::uint64_t>(h_) * (3 * sizeof(double) + 1),
+                        " (a smaller sensor in the scene)");
     bg_ = background_image(scene_.background, scene_.sensor, scene_.seed);
     cur_.assign(n, 0.0);
     next_.assign(n, 0.0);

@@ -445,3 +445,19 @@ def test_classes_show_the_registry_keywords_in_their_signature():
         assert all(p.kind is inspect.Parameter.KEYWORD_ONLY for p in kw)
         assert [(p.name, p.default, p.annotation) for p in kw] == \
             [(p["name"], p["default"], types[p["type"]]) for p in info["params"]]
+
+
+def test_detect_file_leaves_no_output_after_damaged_input(tmp_path):
+    lines = SAMPLE.read_text().splitlines(keepends=True)[:500]
+    bad = tmp_path / "bad.txt"
+    bad.write_text("".join(lines) + "1.0 x y 1\n")
+    out, mask = tmp_path / "c.npy", tmp_path / "m.txt"
+    with pytest.raises(evcorner.InputError, match=r"bad\.txt:501:"):
+        evcorner.detect_file(bad, out, mask=mask)
+    assert not out.exists() and not mask.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.txt"]  # no temporary file either
+    s = evcorner.detect_file(bad, out, mask=mask, allow_damaged=True)
+    assert s["events"] == 500 and ":501:" in s["damaged"]
+    assert len(evcorner.read(out)) == s["corners"] and len(mask.read_text().splitlines()) == 500
+    with pytest.raises(ValueError, match="its folder .*missing does not exist"):
+        evcorner.detect_file(SAMPLE, tmp_path / "missing" / "c.txt")

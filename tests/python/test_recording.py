@@ -7,10 +7,7 @@ import numpy as np
 import pytest
 
 import evcorner
-from conftest import SAMPLE, SHARED, SOURCE, cli_detect
-
-DVS128 = SHARED / "data" / "real" / "dvs128-walking-ouyang" / "alex_walking_for_10secs.aedat"
-
+from conftest import SAMPLE, SOURCE, cli_detect
 
 def _events(xs, ys, sensor=None):
     """Events at (x, y), 1 ms apart, alternating polarity."""
@@ -44,16 +41,6 @@ def test_read_and_chunks_carry_the_files_sensor(tmp_path, cli):
     np.testing.assert_array_equal(mask, cli_mask)
     # (The sensor matters: the 240x180 default gives another mask on these events.)
     assert not np.array_equal(evcorner.detect(events, sensor=(240, 180)), cli_mask)
-
-
-@pytest.mark.skipif(not DVS128.exists(), reason=f"no {DVS128}")
-def test_dvs128_recording_read_then_detect_equals_the_cli(tmp_path, cli):
-    events = evcorner.read(DVS128)
-    assert events.sensor == (128, 128)
-    summary, cli_mask = cli_detect(cli, DVS128, "efast", tmp_path)
-    mask = evcorner.detect(events)
-    assert int(mask.sum()) == summary["corners"]
-    np.testing.assert_array_equal(mask, cli_mask)
 
 
 @pytest.mark.parametrize("ext", ["h5", "aedat4"])

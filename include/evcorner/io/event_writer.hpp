@@ -55,7 +55,9 @@ std::string resolve_output_format(const std::string& path, std::string_view form
 /// (resolve_output_format()). `sensor`: the sensor size for formats that record one
 /// (AEDAT 4.0, HDF5; nullopt: set_sensor() before close(), else AEDAT 4.0 records the
 /// smallest size holding every event and HDF5 none). Throws OutputError, or
-/// std::invalid_argument for the format.
+/// std::invalid_argument for the format, and, before opening anything, for a pipe or
+/// socket (a FIFO's path, or "-" to one) in a format that seeks back to complete its
+/// file: npy, hdf5, and aedat4 without `sensor`.
 ///
 /// `with_score`: each event carries a score (EventWriter::write(events, scores)): text
 /// "t x y p score" lines, a CSV `score` column, a .npy `score` field ('<f8'), HDF5

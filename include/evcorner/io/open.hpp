@@ -15,10 +15,6 @@
 
 namespace evcorner::io {
 
-/// The format names open_event_reader() accepts, besides "auto" and the aliases: the
-/// names of input_formats() (formats.hpp), in its order (a test holds them equal).
-inline constexpr std::string_view kInputFormats = "ecd-text, csv, npy, aedat2, aedat4, evt2, evt3, dat, hdf5, atis-bin, mat, rosbag2, mcap, rosbag";
-
 /// The file-name extensions of the event files open_event_reader() reads, lower case with
 /// the dot: ".txt", ".csv", ".npy", ".aedat", ".aedat2", ".aedat4", ".raw" (EVT 2.0/3.0),
 /// ".dat", ".h5", ".hdf5", ".bin" (ATIS), ".mat", ".bag" (ROS 1), ".db3" (rosbag2 SQLite),

@@ -32,4 +32,20 @@ struct NamedPath {
 /// input. Only stat()s the paths: opens, creates and changes nothing.
 void check_output_paths(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
 
+/// Throws std::invalid_argument, naming the option and path, for an output file that
+/// cannot be created: the path is a folder, its folder does not exist (or is not a
+/// folder), or neither the folder nor an existing file there may be written. Devices,
+/// FIFOs and "-" pass. Checked before anything is read, so that a run fails at once
+/// instead of after its work. Only stat()s and access()es the paths.
+void check_outputs_creatable(const std::vector<NamedPath>& outputs);
+
+/// True when `path` is written as a file (put under its name only when complete):
+/// not "-" and not a device, FIFO or socket; false for those streams, which keep what was
+/// written before an error.
+bool output_is_file(const std::string& path);
+
+/// The same for an output folder that is created when missing (eval --report): it must be
+/// a folder if it exists, else its nearest existing parent must be a folder that may be written.
+void check_output_folder(const NamedPath& folder);
+
 }  // namespace evcorner::io

@@ -9,9 +9,11 @@
 //
 // Data flows one way: reader -> detector -> sinks. Every batch read is detected and
 // written before the next one is (one thread), or before the error of a later read is
-// raised (several threads: reading overlaps detection), so an input error leaves the
-// sinks complete and valid for the events before it (they are closed, then the error is
-// rethrown, unless allow_damaged: then the run ends there and the summary names it).
+// raised (several threads: reading overlaps detection). An input error leaves the sinks
+// unclosed and is rethrown: file outputs are then absent (never a partial result under
+// the output's name), while a stream (standard output, a FIFO) has had the outputs of the
+// events before it. With allow_damaged the run ends there instead: the sinks are closed,
+// complete and valid for the events before the damage, and the summary names it.
 // Detection time is measured around the detector's batch calls only; wall time around
 // the whole run.
 
@@ -135,8 +137,8 @@ void check_detect_options(const DetectOptions& options);
 /// Runs the configured detector over every event of `reader` (sensor: reader.sensor(),
 /// else `fallback`), each batch to every sink in order; closes the sinks at the end.
 /// Throws as check_detect_options() does before reading anything; InputError from the
-/// reader after closing the sinks (not with allow_damaged); InvalidEvent for an event the
-/// detector cannot take; whatever a sink throws (sinks then left unclosed).
+/// reader (sinks left unclosed; with allow_damaged it ends the run instead); InvalidEvent
+/// for an event the detector cannot take; whatever a sink throws (sinks left unclosed).
 DetectSummary run_detect(io::EventReader& reader, const DetectOptions& options, std::span<DetectSink* const> sinks,
                          const ProgressFn& progress = {}, SensorSize fallback = kDavis240);
 
@@ -151,7 +153,9 @@ struct DetectFiles {
 };
 
 /// Opens the input and the outputs (after checking that no output is the input or
-/// another output), runs run_detect() and returns its summary. Outputs are events in the
+/// another output, that every output can be created, and that outputs which must seek
+/// back are not streams), runs run_detect() and returns its summary. On any error the
+/// output files are left absent (an existing file under the name is left as it was). Outputs are events in the
 /// format `to` names (with_score: with their scores, io::kScoredOutputFormats), recording
 /// the sensor size where the format has a field for it.
 DetectSummary detect_file(const DetectFiles& files, const DetectOptions& options, const ProgressFn& progress = {});
