@@ -183,6 +183,51 @@ TEST_F(Cli, MissingFileAndUsageErrors) {
     EXPECT_EQ(r.status, 2);
 }
 
+TEST_F(Cli, EveryUsageErrorHasThePrefixAndTyposGetASuggestion) {
+    const std::string in = "'" + sample_.string() + "'";
+    struct Case {
+        std::string args, says;
+    };
+    const Case cases[] = {
+        {"detect " + in + " --nms-radus 2", "did you mean '--nms-radius'?"},
+        {"detect " + in + " --thread 2", "did you mean '--threads'?"},
+        {"detect " + in + " --nms-radius 2", "--nms-radius: does nothing without --nms"},
+        {"detect " + in + " --nms-time 500", "--nms-time: does nothing without --nms"},
+        {"eval " + in + " --nms-rule decay", "--nms-rule: does nothing without --nms or --compare-nms"},
+        {"render " + in + " -o f.png --polarity 0", "--polarity applies to -k sae only (this is -k corners)"},
+        {"render " + in + " -o f.png -k sae -d harris", "--detector applies to -k corners or space-time or labels only (this is -k sae)"},
+        {"render " + in + " -o f.png --ft-inner 2", "--ft-inner applies to -k labels only"},
+        {"render " + in + " -o f.png --at 1e20", "time '1e20' is out of range"},
+        {"render " + in + " -o f.png --window 1e20", "at most 1e9"},
+        {"detect", "INPUT is required"},
+        {"detect " + in + " --frobnicate", "not expected: --frobnicate"},
+    };
+    for (const Case& c : cases) {
+        const Result r = run(c.args);
+        EXPECT_EQ(r.status, 2) << c.args << "\n" << r.err;
+        EXPECT_EQ(r.err.rfind("evcorner: error: ", 0), 0u) << c.args << "\n" << r.err;
+        EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+    }
+    // --frobnicate is far from every option: no suggestion.
+    EXPECT_EQ(run("detect " + in + " --frobnicate").err.find("did you mean"), std::string::npos);
+    EXPECT_EQ(run("detect " + in + " --nms --nms-radius 2 -q -o /dev/null").status, 0);
+}
+
+TEST_F(Cli, AllocationsANumberDecidesAreCheckedFirst) {
+    const std::string in = "'" + sample_.string() + "'";
+    // 2 x (65535 x 16)^2 x 3 bytes of images: terabytes, refused before reading or drawing.
+    Result r = run("render " + in + " -o f.png --size 65535x65535 --scale 16");
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("render -k corners: a 1048560x1048560 figure (65535x65535 sensor, --scale 16) needs 6.61 TB"),
+              std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(lower --scale"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "f.png"));
+    r = run("bench " + in + " --min-events 1099511627776 --repeat 1");
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("bench --min-events 1099511627776: 1099511640000 replayed events needs 18.7 TB"),
+              std::string::npos) << r.err;
+}
+
 std::vector<std::uint64_t> marked_positions(const fs::path& mask) {
     std::ifstream in(mask);
     std::vector<std::uint64_t> marked;

@@ -522,7 +522,7 @@ void add_render_command(CLI::App& app) {
             std::string list;
             for (const char* k : kinds) {
                 if (o->kind == k) return;
-                list += (list.empty() ? "-k " : " or ") + std::string(k);
+                list += (list.empty() ? "-k " : " or ") + std::string(k);  // "-k corners or space-time"
             }
             throw std::invalid_argument(std::string(option) + " applies to " + list + " only (this is -k " + o->kind +
                                         ")");
