@@ -104,7 +104,7 @@ void run_convert(const ConvertOptions& o) {
                 fmt::print(stderr,
                            "evcorner: {} is not written (--allow-damaged keeps the {} events before the error)\n",
                            o.output, events);
-            else
+            else if (events > 0)
                 fmt::print(stderr, "evcorner: the {} events before the error went to {}\n", events, writer->name());
             throw;
         }
