@@ -153,8 +153,8 @@ std::vector<std::string> csv_rows(const std::string& csv) {
     return rows;
 }
 
-// Issue 15 item 8: inputs with one name were one Table 1 row, their figures overwrote each
-// other and their CSV rows could not be told apart.
+// Inputs of one name (two folders' events.txt) are two Table 1 rows, two sets of figures
+// and two CSV rows that tell them apart.
 TEST_F(CliEval, InputsOfOneNameStayApart) {
     for (const char* d : {"a/shapes_translation", "b/shapes_translation"}) {
         fs::create_directories(dir_ / d);
@@ -192,8 +192,8 @@ TEST_F(CliEval, InputsOfOneNameStayApart) {
     EXPECT_GT(png_size(dir_ / "rep2/figures/a_x.txt#2.sae.png").first, 0u);
 }
 
-// Issue 15 item 22: a folder of event files (not the dataset's layout) was refused with
-// exit 2; report.md had an empty comparison with the paper for sequences not in it.
+// A folder of event files (not the dataset's layout) is evaluated file by file; report.md
+// compares with the paper only the sequences the paper has.
 TEST_F(CliEval, FolderOfEventFilesAndNoPaperRows) {
     fs::create_directories(dir_ / "rec");
     fs::copy_file(sample_, dir_ / "rec/one.txt");
@@ -355,7 +355,7 @@ TEST_F(CliEval, FolderOfRealMatAtisAndBagRecordings) {
     }
 }
 
-// Issue 15 item 9: label --json - mixed the summary into the JSON on standard output.
+// label --json -: standard output holds the JSON alone (the summary goes to stderr).
 TEST_F(CliEval, LabelJsonOnStandardOutputParses) {
     ASSERT_EQ(run_status("detect '" + sample_.string() + "' -q -o corners.txt"), 0);
     ASSERT_EQ(run_status("label corners.txt -o labels.txt"), 0);

@@ -78,7 +78,7 @@ bool is_char_device(const std::string& p) {
     return ::lstat(p.c_str(), &st) == 0 && S_ISCHR(st.st_mode);
 }
 
-// ---------------------------------------------------------------- 1: output onto an input
+// ---------------------------------------------------------------- output onto an input
 
 TEST_F(CliOutputs, AnOutputOntoTheInputIsRefusedBeforeAnythingIsWritten) {
     const std::string same = copy_sample("same.txt");
@@ -133,7 +133,7 @@ TEST_F(CliOutputs, LabelEvalAndRenderRefuseOutputsOntoTheirInputs) {
     }
 }
 
-// ---------------------------------------------------------------- 2: render to a device
+// ---------------------------------------------------------------- render to a device
 
 TEST_F(CliOutputs, RenderToAFullDeviceFailsAndRemovesNothing) {
     const std::string full = full_device();
@@ -147,7 +147,7 @@ TEST_F(CliOutputs, RenderToAFullDeviceFailsAndRemovesNothing) {
     EXPECT_TRUE(fs::is_symlink(dir_ / "f.png"));
 }
 
-// ---------------------------------------------------------------- 3: atomic outputs
+// ---------------------------------------------------------------- atomic outputs
 
 // convert reads standard input, which stays open; once the temporary output file exists,
 // the signal comes. Nothing may be left under the name but what was there before.
@@ -211,7 +211,7 @@ TEST_F(CliOutputs, AFailedWriteLeavesNoPartialFileAndSaysWhy) {
     }
 }
 
-// ---------------------------------------------------------------- 4: two outputs on one
+// ---------------------------------------------------------------- two outputs on one
 
 TEST_F(CliOutputs, TwoOutputsOnOneFileOrOnStandardOutputAreRefused) {
     for (const std::string args :
@@ -236,7 +236,7 @@ TEST_F(CliOutputs, TwoOutputsOnOneFileOrOnStandardOutputAreRefused) {
     EXPECT_EQ(run("detect " + sample() + " -q -o /dev/null --mask /dev/null").status, 0);
 }
 
-// ---------------------------------------------------------------- 5: write failures
+// ---------------------------------------------------------------- write failures
 
 TEST_F(CliOutputs, EveryFailedWriteIsAnError) {
     const std::string full = full_device();
@@ -259,7 +259,7 @@ TEST_F(CliOutputs, EveryFailedWriteIsAnError) {
     EXPECT_TRUE(is_char_device(full));
 }
 
-// ---------------------------------------------------------------- 6: sensor size
+// ---------------------------------------------------------------- sensor size
 
 TEST_F(CliOutputs, OutputsRecordTheSensorSizeOfTheInput) {
     // ECD text says no size: detect runs on 240x180, convert records it when every event fits.
@@ -320,7 +320,7 @@ TEST_F(CliOutputs, RealRecordingsKeepTheirSensorSize) {
     EXPECT_EQ(converted.out, original.out);
 }
 
-// ---------------------------------------------------------------- 18, 19, 20: formats and names
+// ---------------------------------------------------------------- formats and names
 
 TEST_F(CliOutputs, UnknownOutputExtensionsAreRefused) {
     for (const std::string& args : {"convert " + sample() + " x.npz", "convert " + sample() + " x.json",
@@ -376,7 +376,7 @@ TEST_F(CliOutputs, ConvertToStandardOutputWritesText) {
     EXPECT_EQ(io::read_text_file((dir_ / "back.txt").string()), io::read_text_file(sample_.string()));
 }
 
-// ---------------------------------------------------------------- 9, 10: JSON and rates
+// ---------------------------------------------------------------- JSON and rates
 
 TEST_F(CliOutputs, JsonOnStandardOutputIsAllThereIs) {
     Result r = run("info " + sample() + " --json -");
@@ -426,7 +426,7 @@ TEST_F(CliOutputs, ThePeakRateIsNeverBelowTheMean) {
     EXPECT_GE(j["peak_rate_eps"].get<double>(), j["mean_rate_eps"].get<double>());
 }
 
-// ---------------------------------------------------------------- 23: HDF5 reasons
+// ---------------------------------------------------------------- HDF5 reasons
 
 TEST_F(CliOutputs, Hdf5FailuresSayWhyWithoutHdf5sOwnStack) {
     Result r = run("convert " + sample() + " no-such-dir/x.h5");

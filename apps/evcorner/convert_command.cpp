@@ -29,11 +29,7 @@ struct ConvertOptions {
     std::string format = "auto";
     std::string to = "auto";
     std::string size;
-    std::string csv_columns;
-    std::string time_unit;
-    std::string chip;
-    std::string topic;
-    MoreInputOptions more;
+    io::ReaderOptions reader;
     bool skip_invalid = false;
     bool allow_damaged = false;
     bool quiet = false;
@@ -59,15 +55,10 @@ void run_convert(const ConvertOptions& o) {
     io::check_output_paths({{"INPUT", o.input}}, {{"OUTPUT", o.output}});
     io::check_outputs_creatable({{"OUTPUT", o.output}});
     const std::string to = io::resolve_output_format(o.output, o.to);
-    io::ReaderOptions ropts;
+    io::ReaderOptions ropts = o.reader;
     ropts.skip_invalid = o.skip_invalid;
     ropts.fallback_sensor = std::nullopt;  // converting needs no sensor; --size checks one
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
-    ropts.csv_columns = o.csv_columns;
-    ropts.csv_time_unit = o.time_unit;
-    ropts.aedat2_chip = o.chip;
-    ropts.topic = o.topic;
-    o.more.apply(ropts);
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
     // The input's size (--size included) goes into formats that record one.
     const std::optional<SensorSize> sensor = reader->sensor();
@@ -149,9 +140,7 @@ void add_convert_command(CLI::App& app) {
         "bounding box (with a warning). The output appears under its name only when complete.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
     cmd->add_option("OUTPUT", o->output, "Output file (- = standard output, text formats)")->required();
-    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
-    add_topic_option(*cmd, o->topic);
-    add_more_input_options(*cmd, o->more);
+    add_reader_options(*cmd, o->format, o->reader);
     add_output_format_option(*cmd, o->to);
     cmd->add_option("--size", o->size,
                     "Sensor size WxH to check events against (overrides the file's) and to record")

@@ -31,11 +31,6 @@ namespace {
 struct DetectOptions {
     pipeline::DetectFiles files;
     pipeline::DetectOptions run;
-    std::string csv_columns;
-    std::string time_unit;
-    std::string chip;
-    std::string topic;
-    MoreInputOptions more;
     std::string size;
     std::string summary_json;
     bool skip_invalid = false;
@@ -121,12 +116,7 @@ void run_detect(DetectOptions& o) {
     io::ReaderOptions& ropts = o.files.reader;
     ropts.skip_invalid = o.skip_invalid;
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);  // validated by CLI11
-    ropts.csv_columns = o.csv_columns;
-    ropts.csv_time_unit = o.time_unit;
-    ropts.aedat2_chip = o.chip;
-    ropts.topic = o.topic;
     o.run.param_prefix = "--";
-    o.more.apply(ropts);
     if (o.nms) {
         o.nms_params.rule = parse_nms_rule(o.nms_rule);  // validated by CLI11
         o.run.nms = o.nms_params;
@@ -195,9 +185,7 @@ void add_detect_command(CLI::App& app) {
                     "AEDAT 4.0 and HDF5 record the sensor size the detector ran on")
         ->capture_default_str();
     add_output_format_option(*cmd, o->files.to);
-    add_input_options(*cmd, o->files.format, o->csv_columns, o->time_unit, o->chip);
-    add_topic_option(*cmd, o->topic);
-    add_more_input_options(*cmd, o->more);
+    add_reader_options(*cmd, o->files.format, o->files.reader);
     cmd->add_option("--size", o->size,
                     "Sensor size WxH; events outside it are errors [default: the file's own "
                     "size, else 240x180, the DAVIS240C of the Event-Camera Dataset]")

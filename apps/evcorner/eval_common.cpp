@@ -11,13 +11,8 @@
 namespace evcorner::cli {
 
 std::unique_ptr<io::EventReader> open_events(const std::string& path, const InputOptions& o) {
-    io::ReaderOptions ropts;
+    io::ReaderOptions ropts = o.reader;
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
-    ropts.csv_columns = o.csv_columns;
-    ropts.csv_time_unit = o.time_unit;
-    ropts.aedat2_chip = o.chip;
-    ropts.topic = o.topic;
-    o.more.apply(ropts);
     return io::open_event_reader(path, ropts, o.format);
 }
 
@@ -35,9 +30,7 @@ LoadedEvents load_events(const std::string& path, const InputOptions& o, bool pr
 }
 
 void add_load_options(CLI::App& cmd, InputOptions& o) {
-    add_input_options(cmd, o.format, o.csv_columns, o.time_unit, o.chip);
-    add_topic_option(cmd, o.topic);
-    add_more_input_options(cmd, o.more);
+    add_reader_options(cmd, o.format, o.reader);
     cmd.add_option("--size", o.size, "Sensor size WxH [default: the file's own, else 240x180]")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";

@@ -19,12 +19,8 @@ namespace evcorner::cli {
 
 struct InputOptions {
     std::string format = "auto";
-    std::string csv_columns;
-    std::string time_unit;
     std::string size;  ///< WxH, empty: the file's own, else 240x180
-    std::string chip;  ///< AEDAT 2.0 camera, empty: the header's "# AEChip"
-    std::string topic;  ///< ROS bag topic, empty: the bag's one event topic
-    MoreInputOptions more;
+    io::ReaderOptions reader;  ///< the format table's reader options (add_reader_options)
 };
 
 struct LoadedEvents {
@@ -42,7 +38,7 @@ LoadedEvents load_events(const std::string& path, const InputOptions& o, bool pr
 /// The sensor events of `reader` are on: its own, else 240x180.
 SensorSize sensor_of(const io::EventReader& reader);
 
-/// Adds --format, --csv-columns, --time-unit, --chip and --size.
+/// Adds --format and the reader options (add_reader_options), and --size.
 void add_load_options(CLI::App& cmd, InputOptions& o);
 
 /// The feature-track parameters as options (--ft-*); `overlap` receives the name.

@@ -33,11 +33,7 @@ struct InfoOptions {
     std::string input;
     std::string format = "auto";
     std::string size;
-    std::string csv_columns;
-    std::string time_unit;
-    std::string chip;
-    std::string topic;
-    MoreInputOptions more;
+    io::ReaderOptions reader;
     std::string json;
     bool skip_invalid = false;
     bool no_progress = false;
@@ -111,15 +107,10 @@ void run_info(const InfoOptions& o) {
         io::check_output_paths({{"INPUT", o.input}}, {{"--json", o.json}});
         io::check_outputs_creatable({{"--json", o.json}});
     }
-    io::ReaderOptions ropts;
+    io::ReaderOptions ropts = o.reader;
     ropts.skip_invalid = o.skip_invalid;
     ropts.fallback_sensor = std::nullopt;  // describe any file, whatever its size
     if (!o.size.empty()) ropts.sensor = parse_sensor_size(o.size);
-    ropts.csv_columns = o.csv_columns;
-    ropts.csv_time_unit = o.time_unit;
-    ropts.aedat2_chip = o.chip;
-    ropts.topic = o.topic;
-    o.more.apply(ropts);
     const auto reader = io::open_event_reader(o.input, ropts, o.format);
     // With the JSON on standard output, the table goes to standard error.
     std::FILE* human = o.json == "-" ? stderr : stdout;
@@ -202,45 +193,30 @@ void run_info(const InfoOptions& o) {
 
 }  // namespace
 
-void add_input_options(CLI::App& cmd, std::string& format, std::string& csv_columns, std::string& time_unit,
-                       std::string& chip) {
+void add_reader_options(CLI::App& cmd, std::string& format, io::ReaderOptions& reader) {
+    const char* group = "Input";
     cmd.add_option("--format", format, "Input format: auto (from the content), " + io::input_format_names())
         ->capture_default_str()
+        ->group(group)
         ->check([](const std::string& name) {
-            // The names of the format table, and their aliases.
             if (name == "auto" || io::find_input_format(name)) return std::string();
             return "unknown input format '" + name + "' (known: auto, " + io::input_format_names() + ")";
         });
-    cmd.add_option("--csv-columns", csv_columns,
-                   "CSV column order, e.g. x,y,p,t ('_' skips a column) [default: the header row, else t,x,y,p]");
-    cmd.add_option("--time-unit", time_unit,
-                   "Time unit of CSV, .npy and .mat times: us, ns, ms or s [default: floats s, integers us; .mat us] "
-                   "(docs/formats.md, \"Times\")")
-        ->check(CLI::IsMember({"us", "ns", "ms", "s"}));
-    cmd.add_option("--chip", chip,
-                   "AEDAT 2.0: the camera that recorded the file (DVS128, DAVIS240C, DAVIS346, ...), "
-                   "instead of the header's '# AEChip' line")
-        ->check([](const std::string& s) {
-            return io::Aedat2Reader::known_chip(s)
-                       ? std::string()
-                       : "unknown chip (known: DVS128, DAVIS128, DAVIS208, DAVIS240A/B/C, DAVIS346, DAVIS640)";
-        });
-}
-
-void add_topic_option(CLI::App& cmd, std::string& topic) {
-    cmd.add_option("--topic", topic,
-                   "ROS bag: the topic to read (event_camera_msgs/EventPacket or dvs_msgs/EventArray) "
-                   "[default: the bag's one event topic]");
-}
-
-void add_more_input_options(CLI::App& cmd, MoreInputOptions& o) {
-    cmd.add_option("--npy-columns", o.npy_columns,
-                   ".npy: the meaning of a plain (N, 4) array's columns, e.g. x,y,p,t ('_' skips one) "
-                   "[default: t,x,y,p]");
-    cmd.add_option("--mat-var", o.mat_var,
-                   "MATLAB .mat: the variable holding the N x 4 events [default: the only N x 4 numeric one]");
-    cmd.add_option("--mat-columns", o.mat_columns,
-                   "MATLAB .mat: the meaning of the variable's 4 columns ('_' skips one) [default: x,y,p,t]");
+    for (const io::ReaderOptionInfo& info : io::reader_option_infos()) {
+        CLI::Option* opt = cmd.add_option_function<std::string>(
+                                  std::string(info.flag), [&reader, &info](const std::string& v) { info.set(reader, v); },
+                                  std::string(info.help))
+                               ->type_name("TEXT")
+                               ->group(group);
+        // Values the table's readers cannot take are usage errors at once.
+        if (info.flag == "--time-unit") opt->check(CLI::IsMember({"us", "ns", "ms", "s"}));
+        if (info.flag == "--chip")
+            opt->check([](const std::string& s) {
+                return io::Aedat2Reader::known_chip(s)
+                           ? std::string()
+                           : "unknown chip (known: DVS128, DAVIS128, DAVIS208, DAVIS240A/B/C, DAVIS346, DAVIS640)";
+            });
+    }
 }
 
 void add_info_command(CLI::App& app) {
@@ -255,9 +231,7 @@ void add_info_command(CLI::App& app) {
         "cut from the first event, the remainder under 1 ms joined to the last bin (a span\n"
         "under 1 ms is one bin), in events per second of the bin's length: never below the mean.");
     cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
-    add_input_options(*cmd, o->format, o->csv_columns, o->time_unit, o->chip);
-    add_topic_option(*cmd, o->topic);
-    add_more_input_options(*cmd, o->more);
+    add_reader_options(*cmd, o->format, o->reader);
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
         ->check([](const std::string& s) {
             return parse_sensor_size(s) ? std::string() : "expected WxH with sides 1..65536, e.g. 346x260";
