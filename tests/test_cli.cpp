@@ -9,6 +9,7 @@
 
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/text_reader.hpp"
+#include "evcorner/io/formats.hpp"
 #include "cli_test_util.hpp"
 #include "evcorner/registry.hpp"
 
@@ -226,6 +227,18 @@ TEST_F(Cli, AllocationsANumberDecidesAreCheckedFirst) {
     EXPECT_EQ(r.status, 1) << r.err;
     EXPECT_NE(r.err.find("bench --min-events 1099511627776: 1099511640000 replayed events needs 18.7 TB"),
               std::string::npos) << r.err;
+}
+
+TEST_F(Cli, InfoFormatsListsTheFormatTable) {
+    const Result r = run("info --formats");
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const io::InputFormat& f : io::input_formats()) {
+        EXPECT_NE(r.out.find(std::string(f.name) + " "), std::string::npos) << f.name;
+        EXPECT_NE(r.out.find(std::string(f.title)), std::string::npos) << f.name;
+    }
+    EXPECT_NE(r.out.find("options --csv-columns --time-unit"), std::string::npos) << r.out;
+    EXPECT_EQ(run("info --formats '" + sample_.string() + "'").status, 2);
+    EXPECT_EQ(run("info").status, 2);
 }
 
 std::vector<std::uint64_t> marked_positions(const fs::path& mask) {

@@ -37,6 +37,7 @@ struct InfoOptions {
     std::string json;
     bool skip_invalid = false;
     bool no_progress = false;
+    bool formats = false;
 };
 
 // The peak rate, streamed. The span t_first..t_last is cut into 1 ms bins from t_first;
@@ -102,7 +103,27 @@ void add_bag_topics(nlohmann::json& j, const io::BagReader& bag) {
     j["topics"] = topics;
 }
 
+// The format table (io/formats.hpp), one format per block.
+void print_formats() {
+    for (const io::InputFormat& f : io::input_formats()) {
+        fmt::print("{:<9} {}\n", f.name, f.title);
+        if (!f.aliases.empty()) fmt::print("          also --format {}\n", f.aliases);
+        fmt::print("          files {}{}{}\n", f.extensions, f.by_seeking ? "; read by seeking (not from a pipe)" : "",
+                   f.compressed ? "; also gzip, zstd, bzip2 or xz compressed" : "");
+        std::string takes;
+        for (const io::ReaderOptionInfo& r : io::reader_option_infos())
+            if (f.options & r.bit) takes += (takes.empty() ? "" : " ") + std::string(r.flag);
+        if (!takes.empty()) fmt::print("          options {}\n", takes);
+    }
+}
+
 void run_info(const InfoOptions& o) {
+    if (o.formats) {
+        if (!o.input.empty()) throw std::invalid_argument("--formats lists the formats: give no INPUT with it");
+        print_formats();
+        return;
+    }
+    if (o.input.empty()) throw std::invalid_argument("INPUT is required (or --formats for the list of formats)");
     if (!o.json.empty()) {
         io::check_output_paths({{"INPUT", o.input}}, {{"--json", o.json}});
         io::check_outputs_creatable({{"--json", o.json}});
@@ -230,7 +251,9 @@ void add_info_command(CLI::App& app) {
         "Mean rate: events / (last time - first time). Peak rate: the busiest 1 ms bin, bins\n"
         "cut from the first event, the remainder under 1 ms joined to the last bin (a span\n"
         "under 1 ms is one bin), in events per second of the bin's length: never below the mean.");
-    cmd->add_option("INPUT", o->input, "Event file, or - for standard input")->required();
+    cmd->add_option("INPUT", o->input, "Event file, or - for standard input");
+    cmd->add_flag("--formats", o->formats,
+                  "List the formats evcorner reads instead (name, aliases, file names, options they take)");
     add_reader_options(*cmd, o->format, o->reader);
     cmd->add_option("--size", o->size, "Sensor size WxH to check events against (overrides the file's)")
         ->check([](const std::string& s) {
@@ -241,7 +264,7 @@ void add_info_command(CLI::App& app) {
                     "Also write the figures as JSON to this file (- = standard output; the table then "
                     "goes to standard error)");
     cmd->add_flag("--no-progress", o->no_progress, "No progress bar (it shows only on a terminal)");
-    cmd->footer("Example:\n  evcorner info recording.raw");
+    cmd->footer("Examples:\n  evcorner info recording.raw\n  evcorner info --formats");
     cmd->callback([o] { run_info(*o); });
 }
 
