@@ -106,6 +106,15 @@ TEST_F(RenderEval, FtOfZeroSaysNoTrackReachedTheMinimum) {
     ASSERT_EQ(j["runs"].size(), 1u);
     EXPECT_EQ(j["runs"][0]["ft_percent"], 0.0);
     EXPECT_NE(j["runs"][0]["ft_note"].get<std::string>().find(why), std::string::npos);
+    // The truth table's FT column says it too.
+    write("scene.json", kScene);
+    ASSERT_EQ(run("simulate scene.json -o scene.npy --truth scene.truth.csv -q").status, 0);
+    const CliResult t = run("eval scene.npy --truth scene.truth.csv -d efast --repeat 1 -q --no-figures "
+                            "--ft-min-inner 100000 --report rept");
+    ASSERT_EQ(t.status, 0) << t.err;
+    const std::string truth_part = t.out.substr(t.out.find("Against ground truth"));
+    EXPECT_NE(truth_part.find("* scene efast: FT 0.0: " + why), std::string::npos) << t.out;
+    EXPECT_NE(slurp(dir_ / "rept/report.md").find("| 0.0 (" + why), std::string::npos);
     // With the default minimum, tracks are found: no note.
     const CliResult ok = run("eval '" + sample_.string() + "' -d efast --repeat 1 -q --no-figures --report rep2");
     ASSERT_EQ(ok.status, 0) << ok.err;

@@ -524,18 +524,24 @@ double us_per_event(const TruthRow& r) {
     return r.events == 0 ? 0.0 : r.detect_s * 1e6 / static_cast<double>(r.events);
 }
 
-std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown) {
+std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown, const FtNotes& notes = {}) {
     std::string s;
+    const auto note = [&](const TruthRow& r) {
+        const auto it = notes.find({r.sequence, r.detector});
+        return it == notes.end() ? std::string() : it->second;
+    };
     if (markdown) {
         s += "| sequence | detector | corner events | precision % | recall % | AP | loc. median px | loc. mean px | "
              "loc. p90 px | Red. % | smear /corner/ms | FT % | time/event us |\n"
              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const auto& r : rows)
-            s += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} | {:.1f} | "
+            s += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} | {} | "
                              "{:.3f} |\n",
                              r.sequence, r.detector, r.corners, r.m.precision(), r.m.recall(), ap_cell(r), r.err.median,
                              r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners), r.m.smear(),
-                             eval::ft_percent(r.corners, r.on_track), us_per_event(r));
+                             fmt::format("{:.1f}", eval::ft_percent(r.corners, r.on_track)) +
+                                 (note(r).empty() ? "" : " (" + note(r) + ")"),
+                             us_per_event(r));
         return s;
     }
     std::size_t w = 8;
@@ -543,13 +549,17 @@ std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown) {
     s += fmt::format("{:<{}}  {:<18} {:>9} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>8}\n", "sequence", w,
                      "detector", "corners", "P %", "R %", "AP", "med px", "mean", "p90", "Red.%", "smear", "FT %",
                      "us/ev");
-    for (const auto& r : rows)
-        s += fmt::format("{:<{}}  {:<18} {:>9} {:>6.1f} {:>6.1f} {:>6} {:>6.2f} {:>6.2f} {:>6.2f} {:>6.1f} {:>6.2f} {:>6.1f} "
+    std::string footnotes;  // a noted FT gets a '*' and its reason below the table
+    for (const auto& r : rows) {
+        const std::string ft = fmt::format("{:.1f}", eval::ft_percent(r.corners, r.on_track));
+        s += fmt::format("{:<{}}  {:<18} {:>9} {:>6.1f} {:>6.1f} {:>6} {:>6.2f} {:>6.2f} {:>6.2f} {:>6.1f} {:>6.2f} {:>6} "
                          "{:>8.3f}\n",
                          r.sequence, w, r.detector, r.corners, r.m.precision(), r.m.recall(), ap_cell(r), r.err.median,
                          r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners), r.m.smear(),
-                         eval::ft_percent(r.corners, r.on_track), us_per_event(r));
-    return s;
+                         ft + (note(r).empty() ? "" : "*"), us_per_event(r));
+        if (!note(r).empty()) footnotes += fmt::format("* {} {}: FT {}: {}\n", r.sequence, r.detector, ft, note(r));
+    }
+    return s + footnotes;
 }
 
 std::string truth_table_csv(const std::vector<TruthRow>& rows) {
@@ -1003,7 +1013,7 @@ void run_eval(EvalOptions& o) {
         o.match.radius, eval::to_string(o.match.interpolation), o.match.tolerance_us,
         o.match.credit == eval::Credit::all ? "all of them" : "the nearest");
     if (!truth_rows.empty()) {
-        fmt::print("\nAgainst ground truth: {}\n{}", match_rule, truth_table_text(truth_rows, false));
+        fmt::print("\nAgainst ground truth: {}\n{}", match_rule, truth_table_text(truth_rows, false, ft_notes));
         fmt::print("\nMean over the sequences (AP: average precision of the score's PR curve, docs/evaluation.md; "
                    "smear: true corner events per visible truth corner per ms)\n{}",
                    truth_summary_text(truth_rows, false));
@@ -1078,7 +1088,7 @@ void run_eval(EvalOptions& o) {
         md += "## Against ground truth (simulated scenes)\n\nMatching: " + match_rule +
               ". Precision and FT side by side: FT counts corner events on feature tracks found in the detector's "
               "own output, precision those within the radius of a true corner.\n\n" +
-              truth_table_text(truth_rows, true) + "\n### Mean over the sequences\n\n" +
+              truth_table_text(truth_rows, true, ft_notes) + "\n### Mean over the sequences\n\n" +
               truth_summary_text(truth_rows, true) +
               "\nAP: the average precision of the detector's score threshold swept over its corner events "
               "(precision-recall curve; pr_curve.csv); smear: true corner events per visible truth corner per "
