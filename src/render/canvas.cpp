@@ -11,8 +11,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "evcorner/error.hpp"
 #include "evcorner/io/output_file.hpp"
@@ -142,22 +145,16 @@ double text_height(double size) {
     return fe.ascent + fe.descent;
 }
 
+// The figure is kept as its drawing steps, replayed onto each target (an image surface for
+// PNG, an SVG or PDF surface): every target gets the same Cairo calls, and no Cairo object
+// outlives one output.
 struct Canvas::Impl {
-    cairo_surface_t* recording = nullptr;
-    cairo_t* cr = nullptr;
-    ~Impl() {
-        if (cr) cairo_destroy(cr);
-        if (recording) cairo_surface_destroy(recording);
-    }
+    std::vector<std::function<void(cairo_t*)>> steps;
 };
 
 Canvas::Canvas(int width, int height, Rgb background) : impl_(std::make_unique<Impl>()), width_(width), height_(height) {
     if (width < 1 || height < 1 || width > 65535 || height > 65535)
         throw std::invalid_argument("figure size must be 1..65535 on each side");
-    const cairo_rectangle_t extents{0, 0, static_cast<double>(width), static_cast<double>(height)};
-    impl_->recording = cairo_recording_surface_create(CAIRO_CONTENT_COLOR, &extents);
-    impl_->cr = cairo_create(impl_->recording);
-    if (cairo_status(impl_->cr) != CAIRO_STATUS_SUCCESS) throw std::runtime_error("figure: cannot start drawing");
     fill_rect(0, 0, width, height, background);
 }
 
@@ -168,99 +165,111 @@ Canvas::Canvas(Canvas&&) noexcept = default;
 Canvas& Canvas::operator=(Canvas&&) noexcept = default;
 
 void Canvas::line(double x0, double y0, double x1, double y1, Rgb c, double line_width) {
-    cairo_t* cr = impl_->cr;
-    set_colour(cr, c);
-    cairo_set_line_width(cr, line_width);
-    cairo_set_line_cap(cr, CAIRO_LINE_CAP_SQUARE);
-    cairo_move_to(cr, x0, y0);
-    cairo_line_to(cr, x1, y1);
-    cairo_stroke(cr);
+    impl_->steps.push_back([=](cairo_t* cr) {
+        set_colour(cr, c);
+        cairo_set_line_width(cr, line_width);
+        cairo_set_line_cap(cr, CAIRO_LINE_CAP_SQUARE);
+        cairo_move_to(cr, x0, y0);
+        cairo_line_to(cr, x1, y1);
+        cairo_stroke(cr);
+    });
 }
 
 void Canvas::polyline(const std::vector<double>& xy, Rgb c, double line_width) {
     if (xy.size() < 4) return;
-    cairo_t* cr = impl_->cr;
-    set_colour(cr, c);
-    cairo_set_line_width(cr, line_width);
-    cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-    cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-    cairo_move_to(cr, xy[0], xy[1]);
-    for (std::size_t i = 2; i + 1 < xy.size(); i += 2) cairo_line_to(cr, xy[i], xy[i + 1]);
-    cairo_stroke(cr);
+    impl_->steps.push_back([=](cairo_t* cr) {
+        set_colour(cr, c);
+        cairo_set_line_width(cr, line_width);
+        cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+        cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+        cairo_move_to(cr, xy[0], xy[1]);
+        for (std::size_t i = 2; i + 1 < xy.size(); i += 2) cairo_line_to(cr, xy[i], xy[i + 1]);
+        cairo_stroke(cr);
+    });
 }
 
 void Canvas::fill_rect(double x, double y, double w, double h, Rgb c) {
-    cairo_t* cr = impl_->cr;
-    set_colour(cr, c);
-    cairo_rectangle(cr, x, y, w, h);
-    cairo_fill(cr);
+    impl_->steps.push_back([=](cairo_t* cr) {
+        set_colour(cr, c);
+        cairo_rectangle(cr, x, y, w, h);
+        cairo_fill(cr);
+    });
 }
 
 void Canvas::stroke_rect(double x, double y, double w, double h, Rgb c, double line_width) {
-    cairo_t* cr = impl_->cr;
-    set_colour(cr, c);
-    cairo_set_line_width(cr, line_width);
-    cairo_set_line_join(cr, CAIRO_LINE_JOIN_MITER);
-    cairo_rectangle(cr, x, y, w, h);
-    cairo_stroke(cr);
+    impl_->steps.push_back([=](cairo_t* cr) {
+        set_colour(cr, c);
+        cairo_set_line_width(cr, line_width);
+        cairo_set_line_join(cr, CAIRO_LINE_JOIN_MITER);
+        cairo_rectangle(cr, x, y, w, h);
+        cairo_stroke(cr);
+    });
 }
 
 void Canvas::fill_circle(double cx, double cy, double r, Rgb c) {
-    cairo_t* cr = impl_->cr;
-    set_colour(cr, c);
-    cairo_new_sub_path(cr);
-    cairo_arc(cr, cx, cy, r, 0, 2 * M_PI);
-    cairo_fill(cr);
+    impl_->steps.push_back([=](cairo_t* cr) {
+        set_colour(cr, c);
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, cx, cy, r, 0, 2 * M_PI);
+        cairo_fill(cr);
+    });
 }
 
 void Canvas::image(const RgbImage& img, int x, int y) {
     if (img.width() == 0) return;
-    cairo_t* cr = impl_->cr;
-    cairo_surface_t* s = surface_of(img);
-    cairo_save(cr);
-    cairo_set_source_surface(cr, s, x, y);
-    cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
-    cairo_rectangle(cr, x, y, img.width(), img.height());
-    cairo_fill(cr);
-    cairo_restore(cr);
-    cairo_surface_destroy(s);  // the recording keeps its own reference
+    auto copy = std::make_shared<const RgbImage>(img);
+    impl_->steps.push_back([copy, x, y](cairo_t* cr) {
+        cairo_surface_t* s = surface_of(*copy);
+        cairo_save(cr);
+        cairo_set_source_surface(cr, s, x, y);
+        cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
+        cairo_rectangle(cr, x, y, copy->width(), copy->height());
+        cairo_fill(cr);
+        cairo_restore(cr);
+        cairo_surface_destroy(s);
+    });
 }
 
 void Canvas::text(double x, double y, std::string_view text, double size, Rgb c, Align align, VAlign valign,
                   bool vertical) {
     if (text.empty()) return;
-    cairo_t* cr = impl_->cr;
-    use_figure_font(cr, size);
-    const std::string s(text);
-    cairo_text_extents_t e;
-    cairo_text_extents(cr, s.c_str(), &e);
-    cairo_font_extents_t fe;
-    cairo_font_extents(cr, &fe);
-    double dx = 0, dy = 0;  // from the anchor to the baseline's start, along the text
-    if (align == Align::centre) dx = -e.x_advance / 2;
-    if (align == Align::right) dx = -e.x_advance;
-    switch (valign) {
-        case VAlign::top: dy = fe.ascent; break;
-        case VAlign::middle: dy = (fe.ascent - fe.descent) / 2; break;
-        case VAlign::baseline: dy = 0; break;
-        case VAlign::bottom: dy = -fe.descent; break;
-    }
-    cairo_save(cr);
-    cairo_translate(cr, x, y);
-    if (vertical) cairo_rotate(cr, -M_PI / 2);
-    set_colour(cr, c);
-    cairo_move_to(cr, dx, dy);
-    cairo_show_text(cr, s.c_str());
-    cairo_restore(cr);
+    impl_->steps.push_back([=, s = std::string(text)](cairo_t* cr) {
+        use_figure_font(cr, size);
+        cairo_text_extents_t e;
+        cairo_text_extents(cr, s.c_str(), &e);
+        cairo_font_extents_t fe;
+        cairo_font_extents(cr, &fe);
+        double dx = 0, dy = 0;  // from the anchor to the baseline's start, along the text
+        if (align == Align::centre) dx = -e.x_advance / 2;
+        if (align == Align::right) dx = -e.x_advance;
+        switch (valign) {
+            case VAlign::top: dy = fe.ascent; break;
+            case VAlign::middle: dy = (fe.ascent - fe.descent) / 2; break;
+            case VAlign::baseline: dy = 0; break;
+            case VAlign::bottom: dy = -fe.descent; break;
+        }
+        cairo_save(cr);
+        cairo_translate(cr, x, y);
+        if (vertical) cairo_rotate(cr, -M_PI / 2);
+        set_colour(cr, c);
+        cairo_move_to(cr, dx, dy);
+        cairo_show_text(cr, s.c_str());
+        cairo_restore(cr);
+    });
 }
+
+namespace {
+// Every step onto `cr`; its status after them.
+cairo_status_t replay(const std::vector<std::function<void(cairo_t*)>>& steps, cairo_t* cr) {
+    for (const auto& step : steps) step(cr);
+    return cairo_status(cr);
+}
+}  // namespace
 
 RgbImage Canvas::rasterise() const {
     cairo_surface_t* s = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width_, height_);
     cairo_t* cr = cairo_create(s);
-    cairo_surface_flush(impl_->recording);
-    cairo_set_source_surface(cr, impl_->recording, 0, 0);
-    cairo_paint(cr);
-    const cairo_status_t st = cairo_status(cr);
+    const cairo_status_t st = replay(impl_->steps, cr);
     cairo_destroy(cr);
     cairo_surface_flush(s);
     if (st != CAIRO_STATUS_SUCCESS) {
@@ -294,16 +303,15 @@ void Canvas::write(const std::string& path, FigureFormat format) const {
                              : cairo_pdf_surface_create_for_stream(append_to_string, &encoded, width_, height_);
     if (format == FigureFormat::pdf) cairo_pdf_surface_set_metadata(s, CAIRO_PDF_METADATA_CREATOR, "evcorner");
     cairo_t* cr = cairo_create(s);
-    cairo_surface_flush(impl_->recording);
-    cairo_set_source_surface(cr, impl_->recording, 0, 0);
-    cairo_paint(cr);
+    cairo_status_t st = replay(impl_->steps, cr);
     cairo_show_page(cr);
-    cairo_status_t st = cairo_status(cr);
+    if (st == CAIRO_STATUS_SUCCESS) st = cairo_status(cr);
     cairo_destroy(cr);
     cairo_surface_finish(s);
     if (st == CAIRO_STATUS_SUCCESS) st = cairo_surface_status(s);
     cairo_surface_destroy(s);
-    if (st != CAIRO_STATUS_SUCCESS) throw OutputError(path, std::string("cannot encode the figure: ") + cairo_status_to_string(st));
+    if (st != CAIRO_STATUS_SUCCESS)
+        throw OutputError(path, std::string("cannot encode the figure: ") + cairo_status_to_string(st));
     io::OutputFile out(path);
     out.write(encoded);
     out.close();

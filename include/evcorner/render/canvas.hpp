@@ -1,7 +1,7 @@
 #pragma once
 // A figure drawn as vector graphics with Cairo: lines, rectangles, anti-aliased text in
-// DejaVu Sans, and raster images pasted pixel for pixel. Drawn once (Cairo records it),
-// it is written as PNG (rasterised), SVG or PDF.
+// DejaVu Sans, and raster images pasted pixel for pixel. The drawing is kept as its steps
+// and replayed onto each output: PNG (rasterised), SVG or PDF.
 //
 // Coordinates are image pixels: pixel (x, y) covers [x, x + 1) x [y, y + 1), so a line one
 // pixel wide along the pixel centres of row y runs at y + 0.5 and covers that row exactly.
