@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config
   libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  zlib1g-dev libpng-dev
+  zlib1g-dev libpng-dev libcairo2-dev fonts-dejavu-core
   liblz4-dev libzstd-dev libhdf5-dev hdf5-filter-plugin hdf5-filter-plugin-blosc-serial
   clang libclang-rt-14-dev
   libsqlite3-dev libbz2-dev liblzma-dev libmatio-dev

@@ -43,6 +43,7 @@
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
 #include "evcorner/render/figures.hpp"
+#include "evcorner/render/frame.hpp"
 #include "progress.hpp"
 
 namespace evcorner::cli {
@@ -60,6 +61,7 @@ struct EvalOptions {
     int repeat = 5;
     std::string report;
     bool no_figures = false;
+    std::string figure_format = "png";
     bool quiet = false;
     bool no_progress = false;
     InputOptions in;
@@ -379,8 +381,16 @@ void detect_batch(AnyDetector& d, AsyncNms* nms, std::span<const Event> events, 
 
 std::string cell(double v) { return std::isnan(v) ? "-" : fmt::format("{:.1f}", v); }
 
-std::string table1_text(const eval::Table1& t, bool markdown) {
+// Why a Table 1 FT cell is what it is, where the number alone misleads: keyed by
+// (sequence, detector), e.g. "no track reached 30 inner corner events".
+using FtNotes = std::map<std::pair<std::string, std::string>, std::string>;
+
+std::string table1_text(const eval::Table1& t, bool markdown, const FtNotes& notes = {}) {
     std::string s;
+    const auto note = [&](std::size_t r, std::size_t c) {
+        const auto it = notes.find({t.sequences[r], t.detectors[c]});
+        return it == notes.end() ? std::string() : it->second;
+    };
     std::size_t w = 8;
     for (const auto& q : t.sequences) w = std::max(w, q.size());
     if (markdown) {
@@ -391,7 +401,11 @@ std::string table1_text(const eval::Table1& t, bool markdown) {
         s += "\n";
         for (std::size_t r = 0; r < t.sequences.size(); ++r) {
             s += "| " + t.sequences[r] + " |";
-            for (const auto& c : t.cells[r]) s += fmt::format(" {} | {} |", cell(c.reduction), cell(c.ft));
+            for (std::size_t c = 0; c < t.cells[r].size(); ++c) {
+                const std::string why = note(r, c);
+                s += fmt::format(" {} | {}{} |", cell(t.cells[r][c].reduction), cell(t.cells[r][c].ft),
+                                 why.empty() ? "" : " (" + why + ")");
+            }
             s += "\n";
         }
         return s;
@@ -401,12 +415,20 @@ std::string table1_text(const eval::Table1& t, bool markdown) {
     s += fmt::format("\n{:<{}}", "sequence", w);
     for (std::size_t i = 0; i < t.detectors.size(); ++i) s += fmt::format("  {:>6} {:>6}", "Red.", "FT");
     s += "\n";
+    // A noted FT cell gets a '*' and the reason below the table (the columns stay aligned).
+    std::string footnotes;
     for (std::size_t r = 0; r < t.sequences.size(); ++r) {
         s += fmt::format("{:<{}}", t.sequences[r], w);
-        for (const auto& c : t.cells[r]) s += fmt::format("  {:>6} {:>6}", cell(c.reduction), cell(c.ft));
+        for (std::size_t c = 0; c < t.cells[r].size(); ++c) {
+            const std::string why = note(r, c);
+            s += fmt::format("  {:>6} {:>6}", cell(t.cells[r][c].reduction),
+                             cell(t.cells[r][c].ft) + (why.empty() ? "" : "*"));
+            if (!why.empty()) footnotes += fmt::format("* {} {}: FT {}: {}\n", t.sequences[r], t.detectors[c],
+                                                       cell(t.cells[r][c].ft), why);
+        }
         s += "\n";
     }
-    return s;
+    return s + footnotes;
 }
 
 std::string table2_text(const eval::Table2& t, bool markdown) {
@@ -502,18 +524,24 @@ double us_per_event(const TruthRow& r) {
     return r.events == 0 ? 0.0 : r.detect_s * 1e6 / static_cast<double>(r.events);
 }
 
-std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown) {
+std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown, const FtNotes& notes = {}) {
     std::string s;
+    const auto note = [&](const TruthRow& r) {
+        const auto it = notes.find({r.sequence, r.detector});
+        return it == notes.end() ? std::string() : it->second;
+    };
     if (markdown) {
         s += "| sequence | detector | corner events | precision % | recall % | AP | loc. median px | loc. mean px | "
              "loc. p90 px | Red. % | smear /corner/ms | FT % | time/event us |\n"
              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
         for (const auto& r : rows)
-            s += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} | {:.1f} | "
+            s += fmt::format("| {} | {} | {} | {:.1f} | {:.1f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.2f} | {} | "
                              "{:.3f} |\n",
                              r.sequence, r.detector, r.corners, r.m.precision(), r.m.recall(), ap_cell(r), r.err.median,
                              r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners), r.m.smear(),
-                             eval::ft_percent(r.corners, r.on_track), us_per_event(r));
+                             fmt::format("{:.1f}", eval::ft_percent(r.corners, r.on_track)) +
+                                 (note(r).empty() ? "" : " (" + note(r) + ")"),
+                             us_per_event(r));
         return s;
     }
     std::size_t w = 8;
@@ -521,13 +549,17 @@ std::string truth_table_text(const std::vector<TruthRow>& rows, bool markdown) {
     s += fmt::format("{:<{}}  {:<18} {:>9} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>6} {:>8}\n", "sequence", w,
                      "detector", "corners", "P %", "R %", "AP", "med px", "mean", "p90", "Red.%", "smear", "FT %",
                      "us/ev");
-    for (const auto& r : rows)
-        s += fmt::format("{:<{}}  {:<18} {:>9} {:>6.1f} {:>6.1f} {:>6} {:>6.2f} {:>6.2f} {:>6.2f} {:>6.1f} {:>6.2f} {:>6.1f} "
+    std::string footnotes;  // a noted FT gets a '*' and its reason below the table
+    for (const auto& r : rows) {
+        const std::string ft = fmt::format("{:.1f}", eval::ft_percent(r.corners, r.on_track));
+        s += fmt::format("{:<{}}  {:<18} {:>9} {:>6.1f} {:>6.1f} {:>6} {:>6.2f} {:>6.2f} {:>6.2f} {:>6.1f} {:>6.2f} {:>6} "
                          "{:>8.3f}\n",
                          r.sequence, w, r.detector, r.corners, r.m.precision(), r.m.recall(), ap_cell(r), r.err.median,
                          r.err.mean, r.err.p90, eval::reduction_rate(r.events, r.corners), r.m.smear(),
-                         eval::ft_percent(r.corners, r.on_track), us_per_event(r));
-    return s;
+                         ft + (note(r).empty() ? "" : "*"), us_per_event(r));
+        if (!note(r).empty()) footnotes += fmt::format("* {} {}: FT {}: {}\n", r.sequence, r.detector, ft, note(r));
+    }
+    return s + footnotes;
 }
 
 std::string truth_table_csv(const std::vector<TruthRow>& rows) {
@@ -688,7 +720,35 @@ void run_eval(EvalOptions& o) {
     }
     std::vector<eval::RunRecord> runs;
     nlohmann::json jruns = nlohmann::json::array();
+    FtNotes ft_notes;
     std::string figures_md, truth_figures_md, speed_figures_md, pr_figures_md;
+    const render::FigureFormat fig_format = render::parse_figure_format(o.figure_format);
+    const std::string ext(render::figure_extension(fig_format));
+    // figures/<name><ext>, in the --figure-format.
+    const auto save_figure = [&](const std::string& name, const render::Canvas& c) {
+        c.write((fig_dir / (name + ext)).string(), fig_format);
+    };
+    const auto sensor_figure = [&](const render::RgbImage& body, SensorSize size, int scale,
+                                   std::vector<std::string> title, std::vector<render::LegendEntry> legend) {
+        render::FigureFrame f;
+        f.title = std::move(title);
+        f.legend = std::move(legend);
+        return render::frame_sensor_figure(body, size, scale, f).figure;
+    };
+    const auto space_time_figure = [&](std::span<const Event> events, std::span<const Event> corners,
+                                       std::span<const std::uint8_t> labels, SensorSize size, std::int64_t t0,
+                                       std::int64_t t1, std::vector<std::string> title,
+                                       std::vector<render::LegendEntry> legend) {
+        render::FigureFrame f;
+        f.title = std::move(title);
+        f.legend = std::move(legend);
+        const render::RgbImage body = render::render_space_time(events, corners, labels, size, t0, t1);
+        return render::frame_space_time_figure(body, size, t0, t1, {}, f).figure;
+    };
+    const auto interval = [](std::int64_t t0, std::int64_t t1) {
+        return fmt::format("t = {:.6f} s to {:.6f} s", static_cast<double>(t0) * 1e-6, static_cast<double>(t1) * 1e-6);
+    };
+    const render::Rgb event_grey{185, 185, 185};
     const bool show_progress = !o.quiet && !o.no_progress;
     std::vector<Event> batch(kBatch);
     std::vector<std::uint8_t> flags(kBatch);
@@ -770,6 +830,14 @@ void run_eval(EvalOptions& o) {
             const double label_s = std::chrono::duration<double>(Clock::now() - l0).count();
             eval::RunRecord r{seq.name, k.name, n_events, corners.size(), labels.labelled, eval::median(k.seconds)};
             runs.push_back(r);
+            // FT 0 says nothing by itself: no corners, or none on an accepted track.
+            std::string ft_note;
+            if (corners.empty())
+                ft_note = "no corner events";
+            else if (labels.accepted == 0)
+                ft_note = fmt::format("no track reached {} inner corner events with outer <= {} x inner",
+                                      o.params.min_inner, o.params.max_outer_ratio);
+            if (!ft_note.empty()) ft_notes[{seq.name, k.name}] = ft_note;
             nlohmann::json jtruth;
             if (!matched.empty()) {
                 TruthRow tr{seq.name, k.name, n_events, corners.size(), labels.labelled, r.detect_s,
@@ -811,17 +879,23 @@ void run_eval(EvalOptions& o) {
                           {"speed_bins", jbins}};
                 if (figs && !figs->empty()) {
                     const std::string stem = seq.stem + "." + k.name;
-                    render::write_png((fig_dir / (stem + ".loc_error.png")).string(),
-                                      render::render_histogram(seq.name + " " + k.name + ": localisation error of " +
-                                                                   std::to_string(tr.m.true_positives) + " true positives",
-                                                               tr.m.errors, 0.0, o.match.radius, 14, "px"));
-                    render::write_png((fig_dir / (stem + ".truth_space_time.png")).string(),
-                                      render::render_space_time(truth_tracks, corners, tr.m.is_true, size,
-                                                                figs->first_t(),
-                                                                std::max(figs->last_t(), figs->first_t() + 1)));
+                    save_figure(stem + ".loc_error",
+                                render::render_histogram(seq.name + " " + k.name + ": localisation error of the " +
+                                                             std::to_string(tr.m.true_positives) + " true positives",
+                                                         tr.m.errors, 0.0, o.match.radius, 14,
+                                                         "distance to the nearest truth corner [px]",
+                                                         "true positives", k.name + " true positives"));
+                    const std::int64_t t0 = figs->first_t(), t1 = std::max(figs->last_t(), figs->first_t() + 1);
+                    save_figure(stem + ".truth_space_time",
+                                space_time_figure(truth_tracks, corners, tr.m.is_true, size, t0, t1,
+                                                  {seq.name + " " + k.name + ": corner events against the truth",
+                                                   interval(t0, t1)},
+                                                  {{event_grey, "truth corner (every ms)"},
+                                                   {render::kOnTrack, "true corner event"},
+                                                   {render::kOffTrack, "false corner event"}}));
                     truth_figures_md += fmt::format(
-                        "| {} | {} | ![](figures/{}.loc_error.png) | ![](figures/{}.truth_space_time.png) |\n",
-                        seq.name, k.name, stem, stem);
+                        "| {} | {} | ![](figures/{}.loc_error{}) | ![](figures/{}.truth_space_time{}) |\n",
+                        seq.name, k.name, stem, ext, stem, ext);
                 }
                 tr.m.errors = {};
                 tr.m.is_true = {};
@@ -841,26 +915,47 @@ void run_eval(EvalOptions& o) {
                              {"hypotheses", labels.hypotheses},
                              {"label_s", label_s},
                              {"truth", jtruth}});
+            if (!ft_note.empty()) jruns.back()["ft_note"] = ft_note;
             if (figs && !figs->empty()) {
                 const std::int64_t t_first = figs->first_t(), t_last = figs->last_t();
                 const std::string stem = seq.stem + "." + k.name;
-                render::write_png((fig_dir / (stem + ".corners.png")).string(),
-                                  render::upscale(render::render_recent_corners(figs->newest(false), corners, size, t_last), 2));
-                render::write_png((fig_dir / (stem + ".labels.png")).string(),
-                                  render::render_space_time(figs->sample(), corners, labels.on_track, size, t_first,
-                                                            std::max(t_last, t_first + 1)));
-                figures_md += fmt::format("| {} | {} | ![](figures/{}.corners.png) | ![](figures/{}.labels.png) |\n",
-                                          seq.name, k.name, stem, stem);
+                save_figure(stem + ".corners",
+                            sensor_figure(render::upscale(render::render_recent_corners(figs->newest(false), corners,
+                                                                                        size, t_last),
+                                                          2),
+                                          size, 2,
+                                          {seq.name + " " + k.name + ": corner events (Fig. 6)",
+                                           fmt::format("t = {:.6f} s; events of the last 33 ms, corners of the last "
+                                                       "33 ms bright, 33 to 100 ms dark",
+                                                       static_cast<double>(t_last) * 1e-6)},
+                                          {{{150, 150, 150}, "event"},
+                                           {render::kOnBright, "ON corner, last 33 ms"},
+                                           {render::kOnDark, "ON corner, 33 to 100 ms"},
+                                           {render::kOffBright, "OFF corner, last 33 ms"},
+                                           {render::kOffDark, "OFF corner, 33 to 100 ms"}}));
+                const std::int64_t t1 = std::max(t_last, t_first + 1);
+                save_figure(stem + ".labels",
+                            space_time_figure(figs->sample(), corners, labels.on_track, size, t_first, t1,
+                                              {seq.name + " " + k.name +
+                                                   ": corner events labelled by feature tracks (Fig. 5b)",
+                                               interval(t_first, t1) + "; FT " +
+                                                   cell(eval::ft_percent(corners.size(), labels.labelled)) + " %" +
+                                                   (ft_note.empty() ? "" : " (" + ft_note + ")")},
+                                              {{event_grey, "event"},
+                                               {render::kOnTrack, "corner event on a feature track"},
+                                               {render::kOffTrack, "corner event on no track"}}));
+                figures_md += fmt::format("| {} | {} | ![](figures/{}.corners{}) | ![](figures/{}.labels{}) |\n",
+                                          seq.name, k.name, stem, ext, stem, ext);
             }
             if (&k != &kinds.front()) std::vector<Event>().swap(corners);  // the first detector's draw Fig. 1b
         }
         if (!pr_series.empty() && !fig_dir.empty()) {
             std::vector<std::string> cats;
             for (const double r : recall_levels) cats.push_back(fmt::format("{:g}", r));
-            render::write_png((fig_dir / (seq.stem + ".pr.png")).string(),
-                              render::render_line_chart(seq.name + ": precision (interpolated) against recall (%)",
-                                                        cats, pr_series, 100, "%"));
-            pr_figures_md += fmt::format("| {} | ![](figures/{}.pr.png) |\n", seq.name, seq.stem);
+            save_figure(seq.stem + ".pr",
+                        render::render_line_chart(seq.name + ": precision (interpolated) against recall", cats,
+                                                  pr_series, 100, "recall [%]", "precision [%]"));
+            pr_figures_md += fmt::format("| {} | ![](figures/{}.pr{}) |\n", seq.name, seq.stem, ext);
         }
         if (!speed_series.empty() && !fig_dir.empty()) {
             std::vector<std::string> cats;
@@ -870,29 +965,46 @@ void run_eval(EvalOptions& o) {
                 ps.push_back({speed_series[i].name, render::series_colour(i), speed_series[i].precision});
                 rs.push_back({speed_series[i].name, render::series_colour(i), speed_series[i].recall});
             }
-            render::write_png((fig_dir / (seq.stem + ".precision_speed.png")).string(),
-                              render::render_line_chart(seq.name + ": precision against image speed (px/s)", cats, ps,
-                                                        100, "%"));
-            render::write_png((fig_dir / (seq.stem + ".recall_speed.png")).string(),
-                              render::render_line_chart(seq.name + ": recall against image speed (px/s)", cats, rs,
-                                                        100, "%"));
-            speed_figures_md += fmt::format("| {} | ![](figures/{}.precision_speed.png) | ![](figures/{}.recall_speed.png) |\n",
-                                            seq.name, seq.stem, seq.stem);
+            save_figure(seq.stem + ".precision_speed",
+                        render::render_line_chart(seq.name + ": precision against image speed", cats, ps, 100,
+                                                  "image speed [px/s]", "precision [%]"));
+            save_figure(seq.stem + ".recall_speed",
+                        render::render_line_chart(seq.name + ": recall against image speed", cats, rs, 100,
+                                                  "image speed [px/s]", "recall [%]"));
+            speed_figures_md += fmt::format("| {} | ![](figures/{}.precision_speed{}) | ![](figures/{}.recall_speed{}) |\n",
+                                            seq.name, seq.stem, ext, seq.stem, ext);
         }
         if (figs && !figs->empty()) {
             const std::int64_t t_first = figs->first_t(), t_last = figs->last_t();
-            render::write_png((fig_dir / (seq.stem + ".sae.png")).string(),
-                              render::upscale(render::render_sae(figs->newest(true), size, 1, t_last,
-                                                                 std::max<std::int64_t>(1, t_last - t_first)),
-                                              2));
-            render::write_png((fig_dir / (seq.stem + ".space_time.png")).string(),
-                              render::render_space_time(figs->sample(), kinds.front().corners, {}, size, t_first,
-                                                        std::max(t_last, t_first + 1)));
+            {
+                render::FigureFrame f;
+                f.title = {seq.name + ": SAE of the ON events (Fig. 2b)",
+                           fmt::format("t = {:.6f} s", static_cast<double>(t_last) * 1e-6)};
+                f.grey_ramp = true;
+                f.ramp = {"age of the newest ON event:", "0",
+                          fmt::format("{:.6f} s or never", static_cast<double>(t_last - t_first) * 1e-6)};
+                save_figure(seq.stem + ".sae",
+                            render::frame_sensor_figure(
+                                render::upscale(render::render_sae(figs->newest(true), size, 1, t_last,
+                                                                   std::max<std::int64_t>(1, t_last - t_first)),
+                                                2),
+                                size, 2, f)
+                                .figure);
+            }
+            const std::int64_t t1 = std::max(t_last, t_first + 1);
+            save_figure(seq.stem + ".space_time",
+                        space_time_figure(figs->sample(), kinds.front().corners, {}, size, t_first, t1,
+                                          {seq.name + " " + kinds.front().name +
+                                               ": events and corner events in space-time (Fig. 1b)",
+                                           interval(t_first, t1)},
+                                          {{event_grey, "event"},
+                                           {render::kOnBright, "ON corner event"},
+                                           {render::kOffBright, "OFF corner event"}}));
         }
     }
     const eval::Table1 t1 = eval::make_table1(runs);
     const eval::Table2 t2 = eval::make_table2(runs);
-    fmt::print("Table 1: reduction rate (Red.) and corners on feature tracks (FT), %\n{}\n", table1_text(t1, false));
+    fmt::print("Table 1: reduction rate (Red.) and corners on feature tracks (FT), %\n{}\n", table1_text(t1, false, ft_notes));
     fmt::print("Table 2: detection time per event (median of {} runs) and max. event rate\n{}", o.repeat,
                table2_text(t2, false));
     const std::string match_rule = fmt::format(
@@ -902,7 +1014,7 @@ void run_eval(EvalOptions& o) {
         o.match.radius, eval::to_string(o.match.interpolation), o.match.tolerance_us,
         o.match.credit == eval::Credit::all ? "all of them" : "the nearest");
     if (!truth_rows.empty()) {
-        fmt::print("\nAgainst ground truth: {}\n{}", match_rule, truth_table_text(truth_rows, false));
+        fmt::print("\nAgainst ground truth: {}\n{}", match_rule, truth_table_text(truth_rows, false, ft_notes));
         fmt::print("\nMean over the sequences (AP: average precision of the score's PR curve, docs/evaluation.md; "
                    "smear: true corner events per visible truth corner per ms)\n{}",
                    truth_summary_text(truth_rows, false));
@@ -963,7 +1075,7 @@ void run_eval(EvalOptions& o) {
                           "named NAME+nms{}.\n\n",
                           nms_rule_name(nms->rule), nms->radius, nms->rule == NmsRule::window ? "window" : "decay",
                           nms->time_us, o.compare_nms ? " (beside each detector without it)" : "");
-    md += "## Table 1: reduction rate and FT (%)\n\n" + table1_text(t1, true) + "\n";
+    md += "## Table 1: reduction rate and FT (%)\n\n" + table1_text(t1, true, ft_notes) + "\n";
     std::map<std::string, std::string> base;
     for (const auto& q : seqs) base[q.name] = q.base;
     const std::string paper = paper_comparison_md(t1, base);
@@ -977,7 +1089,7 @@ void run_eval(EvalOptions& o) {
         md += "## Against ground truth (simulated scenes)\n\nMatching: " + match_rule +
               ". Precision and FT side by side: FT counts corner events on feature tracks found in the detector's "
               "own output, precision those within the radius of a true corner.\n\n" +
-              truth_table_text(truth_rows, true) + "\n### Mean over the sequences\n\n" +
+              truth_table_text(truth_rows, true, ft_notes) + "\n### Mean over the sequences\n\n" +
               truth_summary_text(truth_rows, true) +
               "\nAP: the average precision of the detector's score threshold swept over its corner events "
               "(precision-recall curve; pr_curve.csv); smear: true corner events per visible truth corner per "
@@ -1000,8 +1112,8 @@ void run_eval(EvalOptions& o) {
     if (!figures_md.empty()) {
         md += "## Figures\n\nCorners of the last 33 ms (bright) and 100 ms (dark), green ON, red OFF (Fig. 6); "
               "corner events in space-time over the whole sequence, green on a feature track, red off it "
-              "(Fig. 5b). Per sequence also `figures/<sequence>.sae.png` (Fig. 2b) and "
-              "`figures/<sequence>.space_time.png` (Fig. 1b, the first detector's corners). The grey events of the "
+              "(Fig. 5b). Per sequence also `figures/<sequence>.sae" + ext + "` (Fig. 2b) and "
+              "`figures/<sequence>.space_time" + ext + "` (Fig. 1b, the first detector's corners). The grey events of the "
               "space-time views are all of a sequence's events up to " + std::to_string(StreamFigures::kSample) +
               ", else a uniform sample of that many.\n\n"
               "| sequence | detector | corners (Fig. 6) | labels (Fig. 5b) |\n|---|---|---|---|\n" +
@@ -1043,7 +1155,12 @@ void add_eval_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
     cmd->add_option("--report", o->report, "Write table1.csv, table2.csv, results.json, report.md and figures/ here");
-    cmd->add_flag("--no-figures", o->no_figures, "No PNG figures in the report");
+    cmd->add_flag("--no-figures", o->no_figures, "No figures in the report");
+    cmd->add_option("--figure-format", o->figure_format,
+                    "The report's figures as png, or as svg or pdf (vector: titles, axes, legends and "
+                    "charts; the event views inside are rasters)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"png", "svg", "pdf"}));
     cmd->add_flag("-q,--quiet", o->quiet, "No progress lines or bars");
     cmd->add_flag("--no-progress", o->no_progress, "No progress bars (shown only when stderr is a terminal)");
     add_load_options(*cmd, o->in);

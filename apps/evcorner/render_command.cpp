@@ -1,4 +1,4 @@
-// evcorner render: the paper's figures as PNG images.
+// evcorner render: the paper's figures as PNG images, or SVG / PDF.
 //
 //   sae         Fig. 2b: SAE of one polarity, grey, newest bright
 //   corners     Fig. 6:  events of the last 33 ms grey, corners of the last 33 / 100 ms
@@ -325,23 +325,26 @@ std::string detector_text(const RenderOptions& o) {
     return s;
 }
 
-// A PNG goes to a file named *.png, or to a device or pipe that already exists (/dev/null,
-// a FIFO): those have no name to mislead.
-void check_output_name(const std::string& path) {
+// The figure's format from its name: *.png, *.svg or *.pdf; a device or pipe that already
+// exists (/dev/null, a FIFO) gets a PNG: those have no name to mislead.
+render::FigureFormat check_output_name(const std::string& path) {
     std::error_code ec;
     const auto st = std::filesystem::status(path, ec);
     if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) &&
         !std::filesystem::is_directory(st))
-        return;
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext != ".png")
-        throw std::invalid_argument("-o " + path + ": render writes PNG images only; give a name ending in .png");
+        return render::FigureFormat::png;
+    const std::string ext = std::filesystem::path(path).extension().string();
+    const auto f = ext.size() == 4 ? render::figure_format_of(ext) : std::nullopt;
+    if (!f)
+        throw std::invalid_argument("-o " + path +
+                                    ": render writes PNG, SVG or PDF images only; give a name ending in .png, .svg "
+                                    "or .pdf");
+    return *f;
 }
 
 void run_render(RenderOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
-    check_output_name(o.output);
+    const render::FigureFormat format = check_output_name(o.output);
     io::check_output_paths({{"INPUT", o.input}, {"--corners", o.corners_file}}, {{"-o", o.output}});
     io::check_outputs_creatable({{"-o", o.output}});
     if (!o.at.empty()) (void)parse_time_option(o.at, 0, 0);  // its syntax, before reading anything
@@ -387,9 +390,9 @@ void run_render(RenderOptions& o) {
     const std::string det = detector_text(o);
 
     render::FigureFrame frame;
-    frame.text_scale = o.scale >= 4 ? 2 : 1;
     std::string what;
-    render::RgbImage img;
+    render::RgbImage img;                   // the figure alone (--no-frame)
+    std::optional<render::Canvas> framed;  // the figure in its frame
     if (o.kind == "sae" || o.kind == "corners") {
         render::RgbImage body;
         if (o.kind == "sae") {
@@ -419,7 +422,7 @@ void run_render(RenderOptions& o) {
         if (o.no_frame)
             img = std::move(body);
         else
-            img = render::frame_sensor_figure(body, k.size, o.scale, frame).image;
+            framed = render::frame_sensor_figure(body, k.size, o.scale, frame).figure;
     } else {
         const std::int64_t t0 = at - window;
         render::SpaceTimeStyle style;
@@ -457,10 +460,14 @@ void run_render(RenderOptions& o) {
         if (o.no_frame)
             img = body;
         else
-            img = render::frame_space_time_figure(body, k.size, t0, at, style, frame).image;
+            framed = render::frame_space_time_figure(body, k.size, t0, at, style, frame).figure;
     }
-    render::write_png(o.output, img);
-    fmt::print(stderr, "render: {} {}x{}, {} -> {}\n", o.kind, img.width(), img.height(), what, o.output);
+    if (!framed && format == render::FigureFormat::png)
+        render::write_png(o.output, img);
+    else
+        (framed ? *framed : framed.emplace(img)).write(o.output, format);
+    const int width = framed ? framed->width() : img.width(), height = framed ? framed->height() : img.height();
+    fmt::print(stderr, "render: {} {}x{}, {} -> {}\n", o.kind, width, height, what, o.output);
 }
 
 }  // namespace
@@ -469,7 +476,8 @@ void add_render_command(CLI::App& app) {
     auto o = std::make_shared<RenderOptions>();
     CLI::App* cmd = app.add_subcommand(
         "render",
-        "Draw the paper's figures as PNG: SAE, corners, space-time view, labelled corners.\n"
+        "Draw the paper's figures as PNG, SVG or PDF (by -o's extension): SAE, corners,\n"
+        "space-time view, labelled corners.\n"
         "Kinds: sae (Fig. 2b), corners (Fig. 6: events of the last 33 ms, corner events of the\n"
         "last 33 ms bright and 100 ms dark, green ON / red OFF), space-time (Fig. 1b) and labels\n"
         "(Fig. 5b: green on a feature track, red off it). Each figure gets a title (file,\n"
@@ -477,7 +485,8 @@ void add_render_command(CLI::App& app) {
         "draws the figure alone. The input is streamed: memory follows the window drawn, not\n"
         "the length of the input.");
     cmd->add_option("INPUT", o->input, "Event file (any format evcorner reads)")->required();
-    cmd->add_option("-o,--output", o->output, "PNG file to write (the name must end in .png, or be an existing device or FIFO)")->required();
+    cmd->add_option("-o,--output", o->output, "Figure to write: .png, .svg or .pdf (the frame as vector graphics, the figure in it a "
+                    "raster), or an existing device or FIFO (PNG)")->required();
     cmd->add_option("-k,--kind", o->kind, "sae, corners, space-time or labels")
         ->capture_default_str()
         ->check(CLI::IsMember({"sae", "corners", "space-time", "labels"}));
@@ -514,7 +523,8 @@ void add_render_command(CLI::App& app) {
         "Examples:\n"
         "  evcorner render events.txt -k corners -o fig6.png --at +0.04\n"
         "  evcorner render events.txt -k labels -d harris -o fig5b.png\n"
-        "  evcorner render events.txt -k sae --polarity 0 --window 30 -o sae.png");
+        "  evcorner render events.txt -k sae --polarity 0 --window 30 -o sae.png\n"
+        "  evcorner render events.txt -k space-time -o fig1b.pdf           (for a paper)");
     cmd->callback([o, cmd] {
         // An option that changes nothing in the figure asked for is a usage error.
         auto only_for = [&](const char* option, std::initializer_list<const char*> kinds) {

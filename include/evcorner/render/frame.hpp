@@ -1,12 +1,14 @@
 #pragma once
 // The frame around a figure: a title naming what is drawn, axes with ticks (sensor pixels,
 // and time for the space-time view), and a legend. The figure itself (figures.hpp) is
-// drawn first and pasted in: the frame reads its geometry, never its pixels.
+// drawn first and pasted in: the frame reads its geometry, never its pixels. The frame is
+// vector graphics (canvas.hpp): written as PNG, SVG or PDF, the body a raster inside it.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "evcorner/render/canvas.hpp"
 #include "evcorner/render/figures.hpp"
 #include "evcorner/render/image.hpp"
 #include "evcorner/sensor.hpp"
@@ -30,16 +32,22 @@ struct FigureFrame {
     std::vector<LegendEntry> legend;
     bool grey_ramp = false;          ///< draw `ramp` in the legend
     GreyRamp ramp;
-    int text_scale = 1;              ///< font pixels per glyph pixel
+    /// Font size in image pixels; 0 picks one from the figure's size (readable from the
+    /// smallest sensors to 1280x720 and larger: the text grows with the image).
+    double text_size = 0;
 };
 
 inline constexpr Rgb kFrameBackground{255, 255, 255}, kFrameInk{30, 30, 30}, kAxisInk{60, 60, 60};
 
 /// Where a framed figure's body went (tests and callers that want to find it).
 struct Framed {
-    RgbImage image;
+    Canvas figure;
     int body_x = 0, body_y = 0;  ///< top-left of the pasted body
+    double text_size = 0;        ///< the font size used, px
 };
+
+/// The font size `text_size = 0` picks for a body of this size: 12 px, more for large bodies.
+double auto_text_size(int body_width, int body_height) noexcept;
 
 /// Ticks for [lo, hi]: multiples of 1, 2 or 5 times a power of ten, the smallest such step
 /// at least `min_step`. Exposed for tests.
