@@ -122,7 +122,9 @@ void add_label_command(CLI::App& app) {
         "label",
         "Label corner events as on a feature track (1) or not (0) and print FT.\n"
         "The ground truth of Mueggler et al. (BMVC 2017, Sec. 3.1.2); FT is the share of corner\n"
-        "events on tracks. Input: corner events of any detector in any format evcorner reads.");
+        "events on tracks. Input: corner events of any detector in any format evcorner reads, in\n"
+        "time order (as detectors write them): labelling streams, its memory does not grow with the\n"
+        "file, and an event earlier than the one before it is an error.");
     cmd->add_option("CORNERS", o->input, "Corner-event file, or - for standard input")->required();
     cmd->add_option("-o,--output", o->output, "Write one line per corner event: 1 on a track, 0 not (- = stdout)");
     cmd->add_option("--json", o->json,

@@ -71,7 +71,8 @@ struct FeatureTrackResult {
     }
 };
 
-/// Labels every corner event of `corners` (any order; time order is not required).
+/// Labels every corner event of `corners` (any order: they are taken in time order, ties in
+/// input order; FeatureTrackStream gives the same on a time-ordered stream, in bounded memory).
 /// Cost: a bucket index over (x, y) with time-sorted buckets; each anchor gathers only
 /// the corners inside its reachable space-time box, never all corners, and counts a
 /// partner's cylinders over the corners on the partner's side of the anchor (quadrant
