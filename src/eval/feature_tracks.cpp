@@ -48,7 +48,6 @@ namespace {
 struct Index {
     std::vector<std::int64_t> t;
     std::vector<float> x, y;
-    std::vector<std::uint32_t> original;  // input position
     std::vector<std::uint32_t> bucket_begin;  // CSR offsets, size buckets + 1
     std::vector<std::uint32_t> bucket_items;
     int cells_x = 0, cells_y = 0, groups = 1, cell = 8;
@@ -59,13 +58,10 @@ struct Index {
     }
 };
 
+// `corners` in time order (ties in any order: their order is the tie-break everywhere).
 Index build_index(std::span<const Event> corners, const FeatureTrackParams& p) {
     Index ix;
     const std::size_t n = corners.size();
-    std::vector<std::uint32_t> order(n);
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::uint32_t a, std::uint32_t b) { return corners[a].t < corners[b].t; });
     int max_x = 0, max_y = 0;
     for (const Event& e : corners) {
         max_x = std::max<int>(max_x, e.x);
@@ -79,12 +75,11 @@ Index build_index(std::span<const Event> corners, const FeatureTrackParams& p) {
     ix.x.resize(n);
     ix.y.resize(n);
     ix.group.resize(n);
-    ix.original = order;
     const std::size_t buckets = static_cast<std::size_t>(ix.groups) * ix.cells_x * ix.cells_y;
     ix.bucket_begin.assign(buckets + 1, 0);
     std::vector<std::uint32_t> bucket_of(n);
     for (std::size_t i = 0; i < n; ++i) {
-        const Event& e = corners[order[i]];
+        const Event& e = corners[i];
         ix.t[i] = e.t;
         ix.x[i] = e.x;
         ix.y[i] = e.y;
@@ -310,19 +305,20 @@ const Kernels& chosen_kernels() noexcept {
     return c;
 }
 
-FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParams& p, const Kernels& kern,
-                         const LabelProgress& progress = {}) {
-    validate(p);
-    if (corners.size() >= std::numeric_limits<std::uint32_t>::max())
-        throw std::invalid_argument("feature tracks: at most 2^32 - 2 corner events");
-    FeatureTrackResult result;
-    const std::size_t n = corners.size();
-    result.on_track.assign(n, 0);
-    if (n == 0) return result;
+struct Counts {
+    std::uint64_t hypotheses = 0, accepted = 0;
+};
 
+// Processes the anchors at positions [first, last) of the time-ordered `corners`, which hold
+// every corner event that any of these anchors can reach (all with t_a <= t <= t_a +
+// max_duration_us of each); `on_track` and `claimed` (exclusive mode) are per position and
+// carry the state of earlier anchors. `progress(k)` is told now and then how many of the
+// anchors are done.
+void process_anchors(std::span<const Event> corners, std::size_t first, std::size_t last, std::uint8_t* on_track,
+                     std::uint8_t* claimed, const FeatureTrackParams& p, const Kernels& kern, Counts& result,
+                     const std::function<void(std::size_t)>& progress = {}) {
+    if (first >= last) return;
     const Index ix = build_index(corners, p);
-    std::vector<std::uint8_t> on_track(n, 0);  // by time-order position
-    std::vector<std::uint8_t> claimed(p.overlap == TrackOverlap::exclusive ? n : 0, 0);
     const bool exclusive = p.overlap == TrackOverlap::exclusive;
     const float r_in2 = static_cast<float>(p.inner_radius * p.inner_radius);
     const float r_out2 = static_cast<float>(p.outer_radius * p.outer_radius);
@@ -338,8 +334,8 @@ FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParam
     Candidates c;
     std::vector<std::uint32_t> cursor(ix.bucket_begin.begin(), ix.bucket_begin.end() - 1);
     std::size_t lo = 0;
-    for (std::size_t a = 0; a < n; ++a) {
-        if (progress && a % 4096 == 0) progress(a, n);
+    for (std::size_t a = first; a < last; ++a) {
+        if (progress && (a - first) % 4096 == 0) progress(a - first);
         if (exclusive && claimed[a]) continue;
         const std::int64_t ta = ix.t[a];
         const std::int64_t t_end = ta + p.max_duration_us;
@@ -465,12 +461,53 @@ FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParam
             }
         }
     }
+}
+
+FeatureTrackResult label(std::span<const Event> corners, const FeatureTrackParams& p, const Kernels& kern,
+                         const LabelProgress& progress = {}) {
+    validate(p);
+    if (corners.size() >= std::numeric_limits<std::uint32_t>::max())
+        throw std::invalid_argument("feature tracks: at most 2^32 - 2 corner events");
+    FeatureTrackResult result;
+    const std::size_t n = corners.size();
+    result.on_track.assign(n, 0);
+    if (n == 0) return result;
+    // Time order, ties by input position; a copy only when the input is not in it already.
+    std::vector<std::uint32_t> order;
+    std::vector<Event> sorted;
+    std::span<const Event> in_order = corners;
+    const bool is_sorted =
+        std::is_sorted(corners.begin(), corners.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
+    if (!is_sorted) {
+        order.resize(n);
+        std::iota(order.begin(), order.end(), 0u);
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::uint32_t a, std::uint32_t b) { return corners[a].t < corners[b].t; });
+        sorted.resize(n);
+        for (std::size_t i = 0; i < n; ++i) sorted[i] = corners[order[i]];
+        in_order = sorted;
+    }
+    std::vector<std::uint8_t> on_track(n, 0);  // by time-order position
+    std::vector<std::uint8_t> claimed(p.overlap == TrackOverlap::exclusive ? n : 0, 0);
+    Counts counts;
+    std::function<void(std::size_t)> tell;
+    if (progress) tell = [&](std::size_t done) { progress(done, n); };
+    process_anchors(in_order, 0, n, on_track.data(), claimed.data(), p, kern, counts, tell);
+    result.hypotheses = counts.hypotheses;
+    result.accepted = counts.accepted;
     for (std::size_t i = 0; i < n; ++i) {
-        result.on_track[ix.original[i]] = on_track[i];
+        result.on_track[is_sorted ? i : order[i]] = on_track[i];
         result.labelled += on_track[i];
     }
     if (progress) progress(n, n);
     return result;
+}
+
+const Kernels& kernels_named(std::string_view path) {
+    if (path.empty()) return chosen_kernels();
+    for (const Kernels& k : all_kernels())
+        if (path == k.name) return k;
+    throw std::invalid_argument("feature tracks: code path '" + std::string(path) + "' does not run on this CPU");
 }
 
 }  // namespace
@@ -484,6 +521,113 @@ FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const Fe
     return label(corners, p, chosen_kernels(), progress);
 }
 
+// The window: corner events from the first one whose label may still change (time order,
+// as pushed), with their labels and claims so far. Positions [0, done) have been anchors
+// already (ties in time with the first anchor still to run).
+struct FeatureTrackStream::State {
+    FeatureTrackParams params;
+    const Kernels* kern = nullptr;
+    std::vector<Event> window;
+    std::vector<std::uint8_t> on_track, claimed;
+    std::size_t done = 0;
+    std::vector<std::uint8_t> out;  // labels made final by the current call
+    std::uint64_t pushed = 0, labelled = 0;
+    Counts counts;
+    std::size_t max_retained = 0;
+    bool finished = false;
+
+    // Runs the anchors [done, last) and hands out the labels of the corners no later
+    // anchor can reach (earlier than the first anchor left).
+    void run(std::size_t last) {
+        const bool exclusive = params.overlap == TrackOverlap::exclusive;
+        process_anchors(window, done, last, on_track.data(), exclusive ? claimed.data() : nullptr, params, *kern,
+                        counts);
+        std::size_t final_count = window.size();
+        if (last < window.size()) {
+            const std::int64_t next = window[last].t;
+            final_count = static_cast<std::size_t>(
+                std::lower_bound(window.begin(), window.end(), next,
+                                 [](const Event& e, std::int64_t t) { return e.t < t; }) -
+                window.begin());
+        }
+        const auto k = static_cast<std::ptrdiff_t>(final_count);
+        out.insert(out.end(), on_track.begin(), on_track.begin() + k);
+        labelled += static_cast<std::uint64_t>(std::count(on_track.begin(), on_track.begin() + k, 1));
+        window.erase(window.begin(), window.begin() + k);
+        on_track.erase(on_track.begin(), on_track.begin() + k);
+        if (exclusive) claimed.erase(claimed.begin(), claimed.begin() + k);
+        done = last - final_count;
+    }
+};
+
+FeatureTrackStream::FeatureTrackStream(const FeatureTrackParams& params, std::string_view path)
+    : s_(std::make_unique<State>()) {
+    validate(params);
+    s_->params = params;
+    s_->kern = &kernels_named(path);
+}
+
+FeatureTrackStream::~FeatureTrackStream() = default;
+FeatureTrackStream::FeatureTrackStream(FeatureTrackStream&&) noexcept = default;
+FeatureTrackStream& FeatureTrackStream::operator=(FeatureTrackStream&&) noexcept = default;
+
+std::span<const std::uint8_t> FeatureTrackStream::push(std::span<const Event> corners) {
+    State& s = *s_;
+    if (s.finished) throw std::logic_error("feature tracks: push() after finish()");
+    s.out.clear();
+    // Time order first, so that a refused batch changes nothing.
+    std::int64_t prev = s.window.empty() ? std::numeric_limits<std::int64_t>::min() : s.window.back().t;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+        if (corners[i].t < prev)
+            throw std::invalid_argument("feature tracks: corner event " + std::to_string(s.pushed + i) + " (t = " +
+                                        std::to_string(corners[i].t) +
+                                        " us) is earlier than the one before it (t = " + std::to_string(prev) +
+                                        " us); the stream must be in time order");
+        prev = corners[i].t;
+    }
+    if (s.window.size() + corners.size() >= std::numeric_limits<std::uint32_t>::max())
+        throw std::invalid_argument("feature tracks: at most 2^32 - 2 corner events within one window");
+    s.window.insert(s.window.end(), corners.begin(), corners.end());
+    s.on_track.resize(s.window.size(), 0);
+    if (s.params.overlap == TrackOverlap::exclusive) s.claimed.resize(s.window.size(), 0);
+    s.pushed += corners.size();
+    if (!s.window.empty()) {
+        // Anchors whose every reachable corner is here: t_a + max_duration < the latest t
+        // (a later push may still bring ties at the latest t).
+        const std::int64_t latest = s.window.back().t;
+        const auto ready = static_cast<std::size_t>(
+            std::lower_bound(s.window.begin(), s.window.end(), latest - s.params.max_duration_us,
+                             [](const Event& e, std::int64_t t) { return e.t < t; }) -
+            s.window.begin());
+        // Each run indexes the whole window: run when it has at least as many anchors to do
+        // as corners it only reads (and at least 4096), so indexing costs O(1) per anchor.
+        const std::size_t todo = ready > s.done ? ready - s.done : 0;
+        if (todo > 0 && todo >= std::max<std::size_t>(4096, s.window.size() - todo)) s.run(ready);
+    }
+    s.max_retained = std::max(s.max_retained, s.window.size());
+    return s.out;
+}
+
+std::span<const std::uint8_t> FeatureTrackStream::finish() {
+    State& s = *s_;
+    s.out.clear();
+    if (!s.finished) {
+        s.finished = true;
+        if (!s.window.empty()) s.run(s.window.size());
+        s.window = {};
+        s.on_track = {};
+        s.claimed = {};
+    }
+    return s.out;
+}
+
+std::uint64_t FeatureTrackStream::corners() const noexcept { return s_->pushed; }
+std::uint64_t FeatureTrackStream::labelled() const noexcept { return s_->labelled; }
+std::uint64_t FeatureTrackStream::hypotheses() const noexcept { return s_->counts.hypotheses; }
+std::uint64_t FeatureTrackStream::accepted() const noexcept { return s_->counts.accepted; }
+std::size_t FeatureTrackStream::retained() const noexcept { return s_->window.size(); }
+std::size_t FeatureTrackStream::max_retained() const noexcept { return s_->max_retained; }
+
 const char* feature_track_code_path() noexcept { return chosen_kernels().name; }
 
 std::vector<std::string> feature_track_code_paths() {
@@ -494,9 +638,7 @@ std::vector<std::string> feature_track_code_paths() {
 
 FeatureTrackResult label_feature_tracks_on_path(std::string_view path, std::span<const Event> corners,
                                                 const FeatureTrackParams& p) {
-    for (const Kernels& k : all_kernels())
-        if (path == k.name) return label(corners, p, k);
-    throw std::invalid_argument("feature tracks: code path '" + std::string(path) + "' does not run on this CPU");
+    return label(corners, p, kernels_named(path));
 }
 
 }  // namespace evcorner::eval

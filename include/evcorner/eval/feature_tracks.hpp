@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -70,7 +71,8 @@ struct FeatureTrackResult {
     }
 };
 
-/// Labels every corner event of `corners` (any order; time order is not required).
+/// Labels every corner event of `corners` (any order: they are taken in time order, ties in
+/// input order; FeatureTrackStream gives the same on a time-ordered stream, in bounded memory).
 /// Cost: a bucket index over (x, y) with time-sorted buckets; each anchor gathers only
 /// the corners inside its reachable space-time box, never all corners, and counts a
 /// partner's cylinders over the corners on the partner's side of the anchor (quadrant
@@ -83,6 +85,46 @@ using LabelProgress = std::function<void(std::size_t done, std::size_t total)>;
 /// label_feature_tracks() reporting its progress.
 FeatureTrackResult label_feature_tracks(std::span<const Event> corners, const FeatureTrackParams& params,
                                         const LabelProgress& progress);
+
+/// The labeller over a stream of corner events in time order, in memory bounded by the
+/// events of one max_duration_us window (not by the stream's length): a corner's label is
+/// final once the stream is past t + max_duration_us, since no hypothesis reaching it can
+/// start later than it. Labels, counts and hypotheses are those of label_feature_tracks()
+/// on the whole stream, however it is cut into batches.
+class FeatureTrackStream {
+public:
+    /// `path`: a code path (feature_track_code_paths()), empty for the default; throws
+    /// std::invalid_argument for bad parameters or a path this CPU does not run.
+    explicit FeatureTrackStream(const FeatureTrackParams& params = {}, std::string_view path = {});
+    ~FeatureTrackStream();
+    FeatureTrackStream(FeatureTrackStream&&) noexcept;
+    FeatureTrackStream& operator=(FeatureTrackStream&&) noexcept;
+
+    /// Appends corner events, in time order (ties allowed), also across calls; an event
+    /// earlier than the one before it throws std::invalid_argument naming its position in
+    /// the stream (counted from 0) and both times, and leaves the stream as it was before
+    /// the call. Returns the labels that became final, 1 = on a track, in input order,
+    /// continuing those returned before; valid until the next call.
+    std::span<const std::uint8_t> push(std::span<const Event> corners);
+    /// Ends the stream: the labels of every corner not yet returned. Later pushes throw
+    /// std::logic_error.
+    std::span<const std::uint8_t> finish();
+
+    [[nodiscard]] std::uint64_t corners() const noexcept;     ///< corner events pushed
+    [[nodiscard]] std::uint64_t labelled() const noexcept;    ///< labels returned with 1
+    [[nodiscard]] std::uint64_t hypotheses() const noexcept;  ///< pairs evaluated so far
+    [[nodiscard]] std::uint64_t accepted() const noexcept;    ///< pairs accepted so far
+    /// Corner events held now, and the most held after any push returned: with W the most
+    /// corner events within any max_duration_us of the stream (both ends included), at most
+    /// 4 W + 4096, whatever the stream's length or the batches (a push holds its batch too
+    /// while it runs).
+    [[nodiscard]] std::size_t retained() const noexcept;
+    [[nodiscard]] std::size_t max_retained() const noexcept;
+
+private:
+    struct State;
+    std::unique_ptr<State> s_;
+};
 
 /// The code path label_feature_tracks() takes: "avx512", "avx2" or "portable" (the
 /// environment variable EVCORNER_LABEL_PATH forces one this CPU runs). Every path gives
