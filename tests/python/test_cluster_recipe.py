@@ -154,11 +154,16 @@ def test_the_documented_commands_in_a_fresh_venv(venv, recordings, tmp_path):
         procs.append(subprocess.Popen(argv(sched_line, ["--host", "127.0.0.1", "--no-dashboard"]), cwd=venv,
                                       env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                       start_new_session=True))
+        # The scheduler creates the file, then writes it: wait until it holds the JSON.
         deadline = time.time() + 60
-        while not sched_file.exists() and time.time() < deadline and procs[0].poll() is None:
-            time.sleep(0.1)
-        assert sched_file.exists(), procs[0].stderr.read().decode() if procs[0].poll() is not None else "no file"
-        assert json.loads(sched_file.read_text())["address"].startswith("tcp://127.0.0.1:")
+        info = None
+        while info is None and time.time() < deadline and procs[0].poll() is None:
+            try:
+                info = json.loads(sched_file.read_text())
+            except (FileNotFoundError, ValueError):
+                time.sleep(0.1)
+        assert info is not None, procs[0].stderr.read().decode() if procs[0].poll() is not None else "no scheduler file"
+        assert info["address"].startswith("tcp://127.0.0.1:")
         for _ in range(2):
             procs.append(subprocess.Popen(argv(worker_line, ["--host", "127.0.0.1", "--no-dashboard"]), cwd=venv,
                                           env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
