@@ -454,10 +454,11 @@ TEST(LuvHarrisParams, OutOfRangeParametersThrowNamingThem) {
 TEST(LuvHarris, MemoryIsStateBytes) {
     for (const SensorSize s : {SensorSize{240, 180}, SensorSize{1280, 720}}) {
         EXPECT_EQ(LuvHarris(s).memory_bytes(), LuvHarris::state_bytes(s));
-        // The TOS (framed by 4) and the table dominate; the refresh's rings are small.
-        const std::uint64_t main = static_cast<std::uint64_t>(s.width + 8) * (s.height + 8) + 8u * s.pixels();
+        // The TOS (framed by 4) and its copy, the table and its stamps dominate; the
+        // refresh's rings and the tile marks are small.
+        const std::uint64_t main = 2u * static_cast<std::uint64_t>(s.width + 8) * (s.height + 8) + 12u * s.pixels();
         EXPECT_GE(LuvHarris::state_bytes(s), main);
-        EXPECT_LT(LuvHarris::state_bytes(s), main + 200u * (s.width + 8));
+        EXPECT_LT(LuvHarris::state_bytes(s), main + 200u * (s.width + 8) + s.pixels() / 7);  // 9 bytes per 8x8 tile
     }
 }
 
