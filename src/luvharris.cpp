@@ -374,6 +374,65 @@ double pixel_value(const std::uint8_t* tos, std::size_t stride, std::size_t x, s
     return luv_harris_response(a, m, c2, k_q, scale);
 }
 
+#ifdef __SSE2__
+// pixel_value for a box block of B <= 7 columns, 8 lanes of 16 bits across the block's
+// columns: the horizontal passes of each window row (|values| <= 4080), the vertical pass
+// (|Ix|, |Iy| <= 24480), the products summed in pairs (_mm_madd_epi16, <= 2 x 24480^2 <
+// 2^31) and widened to 64 bits before the sum over the block.
+template <int G, int B>
+double pixel_value_box_sse2(const std::uint8_t* tos, std::size_t stride, std::size_t x, std::size_t y,
+                            std::int64_t k_q, double scale) noexcept {
+    static_assert(B >= 1 && B <= 7 && (G == 3 || G == 5));
+    constexpr int R = B + G - 1;
+    const __m128i zero = _mm_setzero_si128();
+    __m128i hs[R], hd[R];
+    for (int r = 0; r < R; ++r) {
+        const std::uint8_t* in = tos + (y + static_cast<std::size_t>(r)) * stride + x;
+        __m128i v[G];
+        for (int j = 0; j < G; ++j)
+            v[j] = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + j)), zero);
+        if constexpr (G == 5) {  // smooth 1 4 6 4 1, derivative 1 2 0 -2 -1
+            const __m128i v13 = _mm_add_epi16(v[1], v[3]);
+            hs[r] = _mm_add_epi16(_mm_add_epi16(_mm_add_epi16(v[0], v[4]), _mm_slli_epi16(v13, 2)),
+                                  _mm_add_epi16(_mm_slli_epi16(v[2], 2), _mm_slli_epi16(v[2], 1)));
+            hd[r] = _mm_add_epi16(_mm_sub_epi16(v[0], v[4]), _mm_slli_epi16(_mm_sub_epi16(v[1], v[3]), 1));
+        } else {  // smooth 1 2 1, derivative 1 0 -1
+            hs[r] = _mm_add_epi16(_mm_add_epi16(v[0], v[2]), _mm_slli_epi16(v[1], 1));
+            hd[r] = _mm_sub_epi16(v[0], v[2]);
+        }
+    }
+    const __m128i keep = _mm_cmplt_epi16(_mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7), _mm_set1_epi16(B));
+    __m128i axx = zero, axy = zero, ayy = zero;  // 2 lanes of 64 bits each
+    for (int q = 0; q < B; ++q) {
+        __m128i ix, iy;
+        const __m128i* d = hd + q;
+        const __m128i* sm = hs + q;
+        if constexpr (G == 5) {
+            const __m128i d13 = _mm_add_epi16(d[1], d[3]);
+            ix = _mm_add_epi16(_mm_add_epi16(_mm_add_epi16(d[0], d[4]), _mm_slli_epi16(d13, 2)),
+                               _mm_add_epi16(_mm_slli_epi16(d[2], 2), _mm_slli_epi16(d[2], 1)));
+            iy = _mm_add_epi16(_mm_sub_epi16(sm[0], sm[4]), _mm_slli_epi16(_mm_sub_epi16(sm[1], sm[3]), 1));
+        } else {
+            ix = _mm_add_epi16(_mm_add_epi16(d[0], d[2]), _mm_slli_epi16(d[1], 1));
+            iy = _mm_sub_epi16(sm[0], sm[2]);
+        }
+        ix = _mm_and_si128(ix, keep);
+        iy = _mm_and_si128(iy, keep);
+        const __m128i pxx = _mm_madd_epi16(ix, ix), pyy = _mm_madd_epi16(iy, iy), pxy = _mm_madd_epi16(ix, iy);
+        axx = _mm_add_epi64(axx, _mm_add_epi64(_mm_unpacklo_epi32(pxx, zero), _mm_unpackhi_epi32(pxx, zero)));
+        ayy = _mm_add_epi64(ayy, _mm_add_epi64(_mm_unpacklo_epi32(pyy, zero), _mm_unpackhi_epi32(pyy, zero)));
+        const __m128i sign = _mm_srai_epi32(pxy, 31);
+        axy = _mm_add_epi64(axy, _mm_add_epi64(_mm_unpacklo_epi32(pxy, sign), _mm_unpackhi_epi32(pxy, sign)));
+    }
+    auto sum = [](__m128i v) {
+        alignas(16) std::int64_t l[2];
+        _mm_store_si128(reinterpret_cast<__m128i*>(l), v);
+        return l[0] + l[1];
+    };
+    return luv_harris_response(sum(axx), sum(axy), sum(ayy), k_q, scale);
+}
+#endif
+
 }  // namespace
 
 double LuvHarris::table(int x, int y) const noexcept {
@@ -387,18 +446,24 @@ double LuvHarris::table(int x, int y) const noexcept {
     const std::int32_t* wts = block_weights_.data();
     const int b = params_.block;
     double v;
+#ifdef __SSE2__
+    if (!params_.gaussian_block && b <= 7) {
+        auto* const fn = params_.gradient == 5
+                             ? (b == 1 ? pixel_value_box_sse2<5, 1> : b == 3 ? pixel_value_box_sse2<5, 3>
+                                : b == 5 ? pixel_value_box_sse2<5, 5> : pixel_value_box_sse2<5, 7>)
+                             : (b == 1 ? pixel_value_box_sse2<3, 1> : b == 3 ? pixel_value_box_sse2<3, 3>
+                                : b == 5 ? pixel_value_box_sse2<3, 5> : pixel_value_box_sse2<3, 7>);
+        v = fn(s, stride_, xs, ys, k_q_, scale_);
+    } else
+#endif
     if (params_.gradient == 5) {
         if (params_.gaussian_block)
             v = pixel_value<5, 0, false>(s, stride_, xs, ys, wts, b, k_q_, scale_);
-        else if (b == 5)
-            v = pixel_value<5, 5, true>(s, stride_, xs, ys, wts, b, k_q_, scale_);
         else
             v = pixel_value<5, 0, true>(s, stride_, xs, ys, wts, b, k_q_, scale_);
     } else {
         if (params_.gaussian_block)
             v = pixel_value<3, 0, false>(s, stride_, xs, ys, wts, b, k_q_, scale_);
-        else if (b == 3)
-            v = pixel_value<3, 3, true>(s, stride_, xs, ys, wts, b, k_q_, scale_);
         else
             v = pixel_value<3, 0, true>(s, stride_, xs, ys, wts, b, k_q_, scale_);
     }
