@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -86,8 +87,9 @@ struct BufferSizes {
 constexpr int kTileShift = 3;  // 8x8 tiles of dirty and stale marks
 constexpr int kTile = 1 << kTileShift;
 // A refresh after more than pixels / kLazyFactor events computes the whole table at once
-// (about 10 ns a pixel) rather than value by value when read (about 20 times that each).
-constexpr std::uint64_t kLazyFactor = 20;
+// (measured: about 14 ns a pixel) rather than value by value when read (each event reads at
+// most one; about 45 ns a value with its share of the refresh's copying and marking).
+constexpr std::uint64_t kLazyFactor = 3;
 BufferSizes buffer_sizes(SensorSize s, const LuvHarrisParams& p) {
     const Geometry g = geometry(s, p);
     // The TOS with 16 bytes of slack for update_tos(); the block ring and one accumulator row.
@@ -487,21 +489,28 @@ void LuvHarris::refresh() noexcept {
     const std::size_t tiles_h = (h + kTile - 1) >> kTileShift;
     const std::size_t reach = (static_cast<std::size_t>(pad_) + kTile - 1) >> kTileShift;
     bool border = false;
+    const std::uint8_t* const from = tos_.data();
+    std::uint8_t* const to = snap_.data();
+    const std::size_t stride = stride_;
+    std::uint8_t* const dirty = dirty_.data();
+    std::uint32_t* const stale = stale_since_.data();
+    const std::size_t tiles_w = tiles_w_;
+    const std::uint32_t epoch = epoch_;
     for (const std::uint32_t t : dirty_list_) {
-        dirty_[t] = 0;
-        const std::size_t tx = t % tiles_w_, ty = t / tiles_w_;
+        dirty[t] = 0;
+        const std::size_t tx = t % tiles_w, ty = t / tiles_w;
         const std::size_t x0 = tx << kTileShift, x1 = std::min(x0 + kTile, w);
         const std::size_t y0 = ty << kTileShift, y1 = std::min(y0 + kTile, h);
-        for (std::size_t y = y0; y < y1; ++y) {
-            const std::size_t at = index(static_cast<int>(x0), static_cast<int>(y));
-            std::copy(tos_.data() + at, tos_.data() + at + (x1 - x0), snap_.data() + at);
-        }
+        // 8 bytes a row even where the tile is cut by the sensor's right side: the bytes
+        // beyond it are frame (zero in both, or replicated in the copy: refilled below, the
+        // tile being on the border; the TOS has 16 bytes of slack after its last row).
+        const std::size_t first = index(static_cast<int>(x0), static_cast<int>(y0));
+        for (std::size_t at = first; at < first + (y1 - y0) * stride; at += stride) std::memcpy(to + at, from + at, kTile);
         border = border || x0 == 0 || y0 == 0 || x1 == w || y1 == h;
         const std::size_t sy0 = ty >= reach ? ty - reach : 0, sy1 = std::min(ty + reach, tiles_h - 1);
-        const std::size_t sx0 = tx >= reach ? tx - reach : 0, sx1 = std::min(tx + reach, tiles_w_ - 1);
+        const std::size_t sx0 = tx >= reach ? tx - reach : 0, sx1 = std::min(tx + reach, tiles_w - 1);
         for (std::size_t sy = sy0; sy <= sy1; ++sy)
-            std::fill(stale_since_.begin() + static_cast<std::ptrdiff_t>(sy * tiles_w_ + sx0),
-                      stale_since_.begin() + static_cast<std::ptrdiff_t>(sy * tiles_w_ + sx1 + 1), epoch_);
+            for (std::size_t sx = sx0; sx <= sx1; ++sx) stale[sy * tiles_w + sx] = epoch;
     }
     dirty_list_.clear();
     if (params_.replicate_border && border) fill_border();

@@ -22,7 +22,7 @@
 // Cost: a refresh point keeps a copy of the TOS tiles (8x8) that events changed since the
 // previous one and marks the table values that depend on them as stale; a stale value is
 // computed from that copy when it is read (the same value the whole table would hold). A
-// refresh after many events (more than pixels / 20) computes the whole table at once.
+// refresh after many events (more than pixels / 3) computes the whole table at once.
 
 #include <cstddef>
 #include <cstdint>
