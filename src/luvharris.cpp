@@ -501,9 +501,11 @@ void LuvHarris::refresh() noexcept {
         const std::size_t tx = t % tiles_w, ty = t / tiles_w;
         const std::size_t x0 = tx << kTileShift, x1 = std::min(x0 + kTile, w);
         const std::size_t y0 = ty << kTileShift, y1 = std::min(y0 + kTile, h);
-        // 8 bytes a row even where the tile is cut by the sensor's right side: the bytes
-        // beyond it are frame (zero in both, or replicated in the copy: refilled below, the
-        // tile being on the border; the TOS has 16 bytes of slack after its last row).
+        // 8 bytes a row even where the tile is cut by the sensor's right side. The bytes
+        // beyond it are frame (zero in the TOS; in the copy zero too, or replicated and then
+        // refilled below, the tile being on the border) or, where the frame is narrower, the
+        // next row's first pixels, which take their current value: the copy's value at this
+        // point anyway. The TOS has 16 bytes of slack after its last row.
         const std::size_t first = index(static_cast<int>(x0), static_cast<int>(y0));
         for (std::size_t at = first; at < first + (y1 - y0) * stride; at += stride) std::memcpy(to + at, from + at, kTile);
         border = border || x0 == 0 || y0 == 0 || x1 == w || y1 == h;
