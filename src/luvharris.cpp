@@ -135,7 +135,7 @@ LuvHarris::LuvHarris(SensorSize size, const Params& params, int /*planes*/)
     tiles_w_ = (static_cast<std::size_t>(size_.width) + kTile - 1) >> kTileShift;
     stale_since_.assign(b.tiles, 1);  // every value is stale at the first refresh (epoch 1)
     dirty_.assign(b.tiles, 0);
-    dirty_list_.reserve(b.tiles);
+    dirty_list_ = ZeroedArray<std::uint32_t>(b.tiles);
     hs_ = ZeroedArray<std::int16_t>(b.h_ring);
     hd_ = ZeroedArray<std::int16_t>(b.h_ring);
     xx_ = ZeroedArray<std::int32_t>(b.products);
@@ -154,7 +154,7 @@ std::size_t LuvHarris::memory_bytes() const noexcept {
     return tos_.size() + snap_.size() + table_.size() * sizeof(double) + stamp_.size() * sizeof(std::uint32_t) +
            (hs_.size() + hd_.size()) * sizeof(std::int16_t) + xx_.size() * sizeof(std::int32_t) +
            bxx_.size() * sizeof(std::int64_t) +
-           stale_since_.size() * sizeof(std::uint32_t) + dirty_list_.capacity() * sizeof(std::uint32_t) + dirty_.size();
+           stale_since_.size() * sizeof(std::uint32_t) + dirty_list_.size() * sizeof(std::uint32_t) + dirty_.size();
 }
 
 void LuvHarris::mark_dirty(int x, int y) noexcept {
@@ -167,7 +167,7 @@ void LuvHarris::mark_dirty(int x, int y) noexcept {
             const std::size_t t = static_cast<std::size_t>(ty) * tiles_w_ + static_cast<std::size_t>(tx);
             if (dirty_[t]) continue;
             dirty_[t] = 1;
-            dirty_list_.push_back(static_cast<std::uint32_t>(t));
+            dirty_list_[dirty_count_++] = static_cast<std::uint32_t>(t);
         }
 }
 
@@ -496,7 +496,8 @@ void LuvHarris::refresh() noexcept {
     std::uint32_t* const stale = stale_since_.data();
     const std::size_t tiles_w = tiles_w_;
     const std::uint32_t epoch = epoch_;
-    for (const std::uint32_t t : dirty_list_) {
+    for (std::size_t n = 0; n < dirty_count_; ++n) {
+        const std::uint32_t t = dirty_list_[n];
         dirty[t] = 0;
         const std::size_t tx = t % tiles_w, ty = t / tiles_w;
         const std::size_t x0 = tx << kTileShift, x1 = std::min(x0 + kTile, w);
@@ -514,7 +515,7 @@ void LuvHarris::refresh() noexcept {
         for (std::size_t sy = sy0; sy <= sy1; ++sy)
             for (std::size_t sx = sx0; sx <= sx1; ++sx) stale[sy * tiles_w + sx] = epoch;
     }
-    dirty_list_.clear();
+    dirty_count_ = 0;
     if (params_.replicate_border && border) fill_border();
     if (events_since_refresh_ * kLazyFactor > w * h) {
         const Geometry g = geometry(size_, params_);

@@ -525,6 +525,9 @@ TEST(LuvHarrisParams, OutOfRangeParametersThrowNamingThem) {
 TEST(LuvHarris, MemoryIsStateBytes) {
     for (const SensorSize s : {SensorSize{240, 180}, SensorSize{1280, 720}}) {
         EXPECT_EQ(LuvHarris(s).memory_bytes(), LuvHarris::state_bytes(s));
+        const LuvHarris original(s);
+        const LuvHarris copy(original);  // a copy holds the same buffers
+        EXPECT_EQ(copy.memory_bytes(), LuvHarris::state_bytes(s));
         // The TOS (framed by 4) and its copy, the table and its stamps dominate; the
         // refresh's rings and the tile marks are small.
         const std::uint64_t main = 2u * static_cast<std::uint64_t>(s.width + 8) * (s.height + 8) + 12u * s.pixels();

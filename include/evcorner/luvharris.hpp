@@ -135,7 +135,8 @@ private:
     mutable ZeroedArray<std::uint32_t> stamp_;
     std::vector<std::uint32_t> stale_since_;   // per 8x8 tile of the table
     std::vector<std::uint8_t> dirty_;          // per 8x8 tile of the TOS: changed since the refresh
-    std::vector<std::uint32_t> dirty_list_;    // those tiles, in order of marking
+    ZeroedArray<std::uint32_t> dirty_list_;    // those tiles, in order of marking
+    std::size_t dirty_count_ = 0;
     std::size_t tiles_w_ = 0;
     std::uint32_t epoch_ = 0, full_epoch_ = 0;
     std::uint64_t events_since_refresh_ = 0;
