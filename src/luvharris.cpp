@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -80,13 +81,21 @@ Geometry geometry(SensorSize s, const LuvHarrisParams& p) {
 // The ring buffers' sizes: gradient rows x gw for the two horizontal passes, three
 // product rows of gw, block rows x width for the three horizontal block sums.
 struct BufferSizes {
-    std::size_t tos, table, h_ring, products, b_ring;
+    std::size_t tos, table, h_ring, products, b_ring, tiles;
 };
+
+constexpr int kTileShift = 3;  // 8x8 tiles of dirty and stale marks
+constexpr int kTile = 1 << kTileShift;
+// A refresh after more than pixels / kLazyFactor events computes the whole table at once
+// (measured: about 14 ns a pixel) rather than value by value when read (each event reads at
+// most one; about 45 ns a value with its share of the refresh's copying and marking).
+constexpr std::uint64_t kLazyFactor = 3;
 BufferSizes buffer_sizes(SensorSize s, const LuvHarrisParams& p) {
     const Geometry g = geometry(s, p);
     // The TOS with 16 bytes of slack for update_tos(); the block ring and one accumulator row.
+    const std::size_t tiles = ((g.w + kTile - 1) >> kTileShift) * ((g.h + kTile - 1) >> kTileShift);
     return {g.stride * (g.h + 2 * g.pad) + 16, g.w * g.h, static_cast<std::size_t>(p.gradient) * g.gw, 3 * g.gw,
-            3 * (static_cast<std::size_t>(p.block) + 1) * g.w};
+            3 * (static_cast<std::size_t>(p.block) + 1) * g.w, tiles};
 }
 
 }  // namespace
@@ -120,7 +129,13 @@ LuvHarris::LuvHarris(SensorSize size, const Params& params, int /*planes*/)
     scale_ = 1.0 / (d * d) / 65536.0;
     const BufferSizes b = buffer_sizes(size_, params_);
     tos_ = ZeroedArray<std::uint8_t>(b.tos);
+    snap_ = ZeroedArray<std::uint8_t>(b.tos);
     table_ = ZeroedArray<double>(b.table);
+    stamp_ = ZeroedArray<std::uint32_t>(b.table);
+    tiles_w_ = (static_cast<std::size_t>(size_.width) + kTile - 1) >> kTileShift;
+    stale_since_.assign(b.tiles, 1);  // every value is stale at the first refresh (epoch 1)
+    dirty_.assign(b.tiles, 0);
+    dirty_list_ = ZeroedArray<std::uint32_t>(b.tiles);
     hs_ = ZeroedArray<std::int16_t>(b.h_ring);
     hd_ = ZeroedArray<std::int16_t>(b.h_ring);
     xx_ = ZeroedArray<std::int32_t>(b.products);
@@ -130,13 +145,30 @@ LuvHarris::LuvHarris(SensorSize size, const Params& params, int /*planes*/)
 
 std::uint64_t LuvHarris::state_bytes(SensorSize size, const Params& params, int /*planes*/) noexcept {
     const BufferSizes b = buffer_sizes(size, params);
-    return b.tos + b.table * sizeof(double) + 2 * b.h_ring * sizeof(std::int16_t) +
-           b.products * sizeof(std::int32_t) + b.b_ring * sizeof(std::int64_t);
+    return 2 * b.tos + b.table * (sizeof(double) + sizeof(std::uint32_t)) + 2 * b.h_ring * sizeof(std::int16_t) +
+           b.products * sizeof(std::int32_t) + b.b_ring * sizeof(std::int64_t) +
+           b.tiles * (2 * sizeof(std::uint32_t) + 1);
 }
 
 std::size_t LuvHarris::memory_bytes() const noexcept {
-    return tos_.size() + table_.size() * sizeof(double) + (hs_.size() + hd_.size()) * sizeof(std::int16_t) +
-           xx_.size() * sizeof(std::int32_t) + bxx_.size() * sizeof(std::int64_t);
+    return tos_.size() + snap_.size() + table_.size() * sizeof(double) + stamp_.size() * sizeof(std::uint32_t) +
+           (hs_.size() + hd_.size()) * sizeof(std::int16_t) + xx_.size() * sizeof(std::int32_t) +
+           bxx_.size() * sizeof(std::int64_t) +
+           stale_since_.size() * sizeof(std::uint32_t) + dirty_list_.size() * sizeof(std::uint32_t) + dirty_.size();
+}
+
+void LuvHarris::mark_dirty(int x, int y) noexcept {
+    // The tiles of the TOS update's footprint (the tos_size square clipped to the sensor).
+    const int r = params_.tos_size / 2;
+    const int tx0 = std::max(x - r, 0) >> kTileShift, tx1 = std::min(x + r, size_.width - 1) >> kTileShift;
+    const int ty0 = std::max(y - r, 0) >> kTileShift, ty1 = std::min(y + r, size_.height - 1) >> kTileShift;
+    for (int ty = ty0; ty <= ty1; ++ty)
+        for (int tx = tx0; tx <= tx1; ++tx) {
+            const std::size_t t = static_cast<std::size_t>(ty) * tiles_w_ + static_cast<std::size_t>(tx);
+            if (dirty_[t]) continue;
+            dirty_[t] = 1;
+            dirty_list_[dirty_count_++] = static_cast<std::uint32_t>(t);
+        }
 }
 
 void LuvHarris::update_tos(int x, int y) noexcept {
@@ -173,10 +205,10 @@ void LuvHarris::update_tos(int x, int y) noexcept {
     tos_[index(x, y)] = 255;
 }
 
-void LuvHarris::fill_border() noexcept {
+void LuvHarris::fill_border() noexcept {  // of the copy the table reads
     const std::size_t p = static_cast<std::size_t>(pad_), w = static_cast<std::size_t>(size_.width),
                       h = static_cast<std::size_t>(size_.height);
-    std::uint8_t* t = tos_.data();
+    std::uint8_t* t = snap_.data();
     for (std::size_t y = p; y < p + h; ++y) {
         std::uint8_t* row = t + y * stride_;
         std::fill(row, row + p, row[p]);
@@ -299,16 +331,205 @@ void refresh_table(const Geometry& g, const std::uint8_t* tos, const RefreshBuff
     }
 }
 
+// One table value: the sums refresh_table forms for sensor pixel (x, y), whose window of
+// the framed TOS starts at row y, column x (integers, exact in any order: the same value).
+// B: the block side at compile time (0: b at run time, at most 15).
+template <int G, int B, bool Box>
+double pixel_value(const std::uint8_t* tos, std::size_t stride, std::size_t x, std::size_t y, const std::int32_t* wts,
+                   int b_run, std::int64_t k_q, double scale) noexcept {
+    constexpr const int* smooth = Taps<G>::smooth;
+    constexpr const int* deriv = Taps<G>::deriv;
+    constexpr int kMaxB = B > 0 ? B : 15;
+    const int b = B > 0 ? B : b_run;
+    std::int32_t hs[kMaxB + G - 1][kMaxB], hd[kMaxB + G - 1][kMaxB];
+    for (int r = 0; r < b + G - 1; ++r) {
+        const std::uint8_t* in = tos + (y + static_cast<std::size_t>(r)) * stride + x;
+        for (int c = 0; c < b; ++c) {
+            int sv = 0, dv = 0;
+            for (int j = 0; j < G; ++j) {
+                sv += smooth[j] * in[c + j];
+                dv += deriv[j] * in[c + j];
+            }
+            hs[r][c] = sv;
+            hd[r][c] = dv;
+        }
+    }
+    std::int64_t a = 0, m = 0, c2 = 0;
+    for (int q = 0; q < b; ++q) {
+        std::int64_t rxx = 0, rxy = 0, ryy = 0;
+        for (int c = 0; c < b; ++c) {
+            int ix = 0, iy = 0;
+            for (int i = 0; i < G; ++i) {
+                ix += smooth[i] * hd[q + i][c];
+                iy += deriv[i] * hs[q + i][c];
+            }
+            const std::int64_t wc = Box ? 1 : wts[c];
+            rxx += wc * (ix * ix);
+            rxy += wc * (ix * iy);
+            ryy += wc * (iy * iy);
+        }
+        const std::int64_t wq = Box ? 1 : wts[q];
+        a += wq * rxx;
+        m += wq * rxy;
+        c2 += wq * ryy;
+    }
+    return luv_harris_response(a, m, c2, k_q, scale);
+}
+
+#ifdef __SSE2__
+// pixel_value for a box block of B <= 7 columns, 8 lanes of 16 bits across the block's
+// columns: the horizontal passes of each window row (|values| <= 4080), the vertical pass
+// (|Ix|, |Iy| <= 24480), the products summed in pairs (_mm_madd_epi16, <= 2 x 24480^2 <
+// 2^31) and widened to 64 bits before the sum over the block.
+template <int G, int B>
+double pixel_value_box_sse2(const std::uint8_t* tos, std::size_t stride, std::size_t x, std::size_t y,
+                            std::int64_t k_q, double scale) noexcept {
+    static_assert(B >= 1 && B <= 7 && (G == 3 || G == 5));
+    constexpr int R = B + G - 1;
+    const __m128i zero = _mm_setzero_si128();
+    __m128i hs[R], hd[R];
+    for (int r = 0; r < R; ++r) {
+        const std::uint8_t* in = tos + (y + static_cast<std::size_t>(r)) * stride + x;
+        __m128i v[G];
+        for (int j = 0; j < G; ++j)
+            v[j] = _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(in + j)), zero);
+        if constexpr (G == 5) {  // smooth 1 4 6 4 1, derivative 1 2 0 -2 -1
+            const __m128i v13 = _mm_add_epi16(v[1], v[3]);
+            hs[r] = _mm_add_epi16(_mm_add_epi16(_mm_add_epi16(v[0], v[4]), _mm_slli_epi16(v13, 2)),
+                                  _mm_add_epi16(_mm_slli_epi16(v[2], 2), _mm_slli_epi16(v[2], 1)));
+            hd[r] = _mm_add_epi16(_mm_sub_epi16(v[0], v[4]), _mm_slli_epi16(_mm_sub_epi16(v[1], v[3]), 1));
+        } else {  // smooth 1 2 1, derivative 1 0 -1
+            hs[r] = _mm_add_epi16(_mm_add_epi16(v[0], v[2]), _mm_slli_epi16(v[1], 1));
+            hd[r] = _mm_sub_epi16(v[0], v[2]);
+        }
+    }
+    const __m128i keep = _mm_cmplt_epi16(_mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7), _mm_set1_epi16(B));
+    __m128i axx = zero, axy = zero, ayy = zero;  // 2 lanes of 64 bits each
+    for (int q = 0; q < B; ++q) {
+        __m128i ix, iy;
+        const __m128i* d = hd + q;
+        const __m128i* sm = hs + q;
+        if constexpr (G == 5) {
+            const __m128i d13 = _mm_add_epi16(d[1], d[3]);
+            ix = _mm_add_epi16(_mm_add_epi16(_mm_add_epi16(d[0], d[4]), _mm_slli_epi16(d13, 2)),
+                               _mm_add_epi16(_mm_slli_epi16(d[2], 2), _mm_slli_epi16(d[2], 1)));
+            iy = _mm_add_epi16(_mm_sub_epi16(sm[0], sm[4]), _mm_slli_epi16(_mm_sub_epi16(sm[1], sm[3]), 1));
+        } else {
+            ix = _mm_add_epi16(_mm_add_epi16(d[0], d[2]), _mm_slli_epi16(d[1], 1));
+            iy = _mm_sub_epi16(sm[0], sm[2]);
+        }
+        ix = _mm_and_si128(ix, keep);
+        iy = _mm_and_si128(iy, keep);
+        const __m128i pxx = _mm_madd_epi16(ix, ix), pyy = _mm_madd_epi16(iy, iy), pxy = _mm_madd_epi16(ix, iy);
+        axx = _mm_add_epi64(axx, _mm_add_epi64(_mm_unpacklo_epi32(pxx, zero), _mm_unpackhi_epi32(pxx, zero)));
+        ayy = _mm_add_epi64(ayy, _mm_add_epi64(_mm_unpacklo_epi32(pyy, zero), _mm_unpackhi_epi32(pyy, zero)));
+        const __m128i sign = _mm_srai_epi32(pxy, 31);
+        axy = _mm_add_epi64(axy, _mm_add_epi64(_mm_unpacklo_epi32(pxy, sign), _mm_unpackhi_epi32(pxy, sign)));
+    }
+    auto sum = [](__m128i v) {
+        alignas(16) std::int64_t l[2];
+        _mm_store_si128(reinterpret_cast<__m128i*>(l), v);
+        return l[0] + l[1];
+    };
+    return luv_harris_response(sum(axx), sum(axy), sum(ayy), k_q, scale);
+}
+#endif
+
 }  // namespace
 
+double LuvHarris::table(int x, int y) const noexcept {
+    const std::size_t w = static_cast<std::size_t>(size_.width);
+    const std::size_t i = static_cast<std::size_t>(y) * w + static_cast<std::size_t>(x);
+    if (!refreshed_) return table_[i];
+    const std::size_t t = static_cast<std::size_t>(y >> kTileShift) * tiles_w_ + static_cast<std::size_t>(x >> kTileShift);
+    if (std::max(stamp_[i], full_epoch_) >= stale_since_[t]) return table_[i];
+    const std::uint8_t* s = snap_.data();
+    const std::size_t xs = static_cast<std::size_t>(x), ys = static_cast<std::size_t>(y);
+    const std::int32_t* wts = block_weights_.data();
+    const int b = params_.block;
+    double v;
+#ifdef __SSE2__
+    if (!params_.gaussian_block && b <= 7) {
+        auto* const fn = params_.gradient == 5
+                             ? (b == 1 ? pixel_value_box_sse2<5, 1> : b == 3 ? pixel_value_box_sse2<5, 3>
+                                : b == 5 ? pixel_value_box_sse2<5, 5> : pixel_value_box_sse2<5, 7>)
+                             : (b == 1 ? pixel_value_box_sse2<3, 1> : b == 3 ? pixel_value_box_sse2<3, 3>
+                                : b == 5 ? pixel_value_box_sse2<3, 5> : pixel_value_box_sse2<3, 7>);
+        v = fn(s, stride_, xs, ys, k_q_, scale_);
+    } else
+#endif
+    if (params_.gradient == 5) {
+        if (params_.gaussian_block)
+            v = pixel_value<5, 0, false>(s, stride_, xs, ys, wts, b, k_q_, scale_);
+        else
+            v = pixel_value<5, 0, true>(s, stride_, xs, ys, wts, b, k_q_, scale_);
+    } else {
+        if (params_.gaussian_block)
+            v = pixel_value<3, 0, false>(s, stride_, xs, ys, wts, b, k_q_, scale_);
+        else
+            v = pixel_value<3, 0, true>(s, stride_, xs, ys, wts, b, k_q_, scale_);
+    }
+    table_[i] = v;
+    stamp_[i] = epoch_;
+    ++computed_;
+    return v;
+}
+
 void LuvHarris::refresh() noexcept {
-    if (params_.replicate_border) fill_border();
-    const Geometry g = geometry(size_, params_);
-    const RefreshBuffers buf{hs_.data(), hd_.data(), xx_.data(), bxx_.data(), bxx_.data() + 3 * g.w * static_cast<std::size_t>(params_.block)};
-    const bool box = !params_.gaussian_block;
-    auto* const run = params_.gradient == 5 ? (box ? refresh_table<5, true> : refresh_table<5, false>)
-                                            : (box ? refresh_table<3, true> : refresh_table<3, false>);
-    run(g, tos_.data(), buf, block_weights_, k_q_, scale_, table_.data());
+    if (epoch_ == UINT32_MAX) {  // epochs start again: every value stale
+        std::fill(stamp_.data(), stamp_.data() + stamp_.size(), 0u);
+        std::fill(stale_since_.begin(), stale_since_.end(), 1u);
+        full_epoch_ = 0;
+        epoch_ = 0;
+    }
+    ++epoch_;
+    // The copy takes the tiles events changed; the table values within the response's
+    // reach (pad) of them become stale.
+    const std::size_t w = static_cast<std::size_t>(size_.width), h = static_cast<std::size_t>(size_.height);
+    const std::size_t tiles_h = (h + kTile - 1) >> kTileShift;
+    const std::size_t reach = (static_cast<std::size_t>(pad_) + kTile - 1) >> kTileShift;
+    bool border = false;
+    const std::uint8_t* const from = tos_.data();
+    std::uint8_t* const to = snap_.data();
+    const std::size_t stride = stride_;
+    std::uint8_t* const dirty = dirty_.data();
+    std::uint32_t* const stale = stale_since_.data();
+    const std::size_t tiles_w = tiles_w_;
+    const std::uint32_t epoch = epoch_;
+    for (std::size_t n = 0; n < dirty_count_; ++n) {
+        const std::uint32_t t = dirty_list_[n];
+        dirty[t] = 0;
+        const std::size_t tx = t % tiles_w, ty = t / tiles_w;
+        const std::size_t x0 = tx << kTileShift, x1 = std::min(x0 + kTile, w);
+        const std::size_t y0 = ty << kTileShift, y1 = std::min(y0 + kTile, h);
+        // 8 bytes a row even where the tile is cut by the sensor's right side. The bytes
+        // beyond it are frame (zero in the TOS; in the copy zero too, or replicated and then
+        // refilled below, the tile being on the border) or, where the frame is narrower, the
+        // next row's first pixels, which take their current value: the copy's value at this
+        // point anyway. The TOS has 16 bytes of slack after its last row.
+        const std::size_t first = index(static_cast<int>(x0), static_cast<int>(y0));
+        for (std::size_t at = first; at < first + (y1 - y0) * stride; at += stride) std::memcpy(to + at, from + at, kTile);
+        border = border || x0 == 0 || y0 == 0 || x1 == w || y1 == h;
+        const std::size_t sy0 = ty >= reach ? ty - reach : 0, sy1 = std::min(ty + reach, tiles_h - 1);
+        const std::size_t sx0 = tx >= reach ? tx - reach : 0, sx1 = std::min(tx + reach, tiles_w - 1);
+        for (std::size_t sy = sy0; sy <= sy1; ++sy)
+            for (std::size_t sx = sx0; sx <= sx1; ++sx) stale[sy * tiles_w + sx] = epoch;
+    }
+    dirty_count_ = 0;
+    if (params_.replicate_border && border) fill_border();
+    if (events_since_refresh_ * kLazyFactor > w * h) {
+        const Geometry g = geometry(size_, params_);
+        const RefreshBuffers buf{hs_.data(), hd_.data(), xx_.data(), bxx_.data(),
+                                 bxx_.data() + 3 * g.w * static_cast<std::size_t>(params_.block)};
+        const bool box = !params_.gaussian_block;
+        auto* const run = params_.gradient == 5 ? (box ? refresh_table<5, true> : refresh_table<5, false>)
+                                                : (box ? refresh_table<3, true> : refresh_table<3, false>);
+        run(g, snap_.data(), buf, block_weights_, k_q_, scale_, table_.data());
+        full_epoch_ = epoch_;
+        computed_ += w * h;
+        ++full_refreshes_;
+    }
+    events_since_refresh_ = 0;
     refreshed_ = true;
     ++refreshes_;
 }
@@ -337,6 +558,8 @@ bool LuvHarris::process_unchecked(const Event& e) noexcept {
 
     // 2. The surface.
     update_tos(e.x, e.y);
+    mark_dirty(e.x, e.y);
+    ++events_since_refresh_;
 
     // 3. The look-up and the threshold.
     if (!refreshed_) {

@@ -212,6 +212,77 @@ TEST(LuvHarrisTable, EqualsTheDefinitionOnRandomSurfaces) {
     std::printf("table: %zu pixels compared, %zu non-zero\n", compared, nonzero);
 }
 
+// The table as refreshes leave it (copied TOS tiles, stale values computed when read, or
+// the whole table after many events) equals the whole table recomputed from the TOS of the
+// refresh point, after random runs of events of random lengths, whichever pixels were read
+// in between.
+TEST(LuvHarrisTable, IncrementalEqualsAFullRecompute) {
+    std::vector<LuvHarrisParams> sets;
+    for (const int g : {3, 5})
+        for (const int b : {1, 3, 5, 7, 9, 15}) {
+            LuvHarrisParams p;
+            p.gradient = g;
+            p.block = b;
+            p.replicate_border = b % 4 == 1;
+            p.tos_size = b == 7 ? 15 : b == 3 ? 3 : 7;
+            sets.push_back(p);
+        }
+    for (const int b : {3, 5, 9}) {
+        LuvHarrisParams p;
+        p.gaussian_block = true;
+        p.block = b;
+        p.gradient = b == 5 ? 3 : 5;
+        p.replicate_border = b != 9;
+        sets.push_back(p);
+    }
+    std::uint64_t lazy = 0, full = 0, computed = 0, possible = 0, checked = 0;
+    for (const SensorSize s : {SensorSize{9, 7}, SensorSize{33, 17}, SensorSize{64, 48}})
+        for (std::size_t k = 0; k < sets.size(); ++k) {
+            LuvHarrisParams p = sets[k];
+            p.refresh_us = 0;
+            p.refresh_events = std::int64_t{1} << 40;  // refreshed by the test only
+            LuvHarris d(s, p);
+            std::mt19937_64 rng(static_cast<std::uint64_t>(s.width) * 1000 + k);
+            std::uniform_real_distribution<double> unit(0.0, 1.0);
+            double bx = unit(rng) * s.width, by = unit(rng) * s.height;
+            for (int round = 0; round < 40; ++round) {
+                // Mostly short runs (values computed when read), now and then a long one.
+                const std::int64_t n = round % 9 == 8 ? s.pixels() : 1 + static_cast<std::int64_t>(rng() % 12);
+                for (std::int64_t i = 0; i < n; ++i) {
+                    bx = std::clamp(bx + (unit(rng) - 0.5) * 2, 0.0, s.width - 1.0);
+                    by = std::clamp(by + (unit(rng) - 0.5) * 2, 0.0, s.height - 1.0);
+                    const bool noise = rng() % 8 == 0;
+                    const int x = noise ? static_cast<int>(rng() % s.width) : static_cast<int>(bx);
+                    const int y = noise ? static_cast<int>(rng() % s.height) : static_cast<int>(by);
+                    d.process(ev(round, x, y));
+                }
+                const std::uint64_t fulls = d.full_refreshes();
+                d.refresh();
+                (d.full_refreshes() > fulls ? full : lazy) += 1;
+                const auto want = naive::luv_harris_image_naive(flat_tos(d), s, p);
+                // Read every pixel, or a random third of them (the others stay stale).
+                const bool all = round % 5 == 4;
+                for (int y = 0; y < s.height; ++y)
+                    for (int x = 0; x < s.width; ++x) {
+                        if (!all && rng() % 3 != 0) continue;
+                        ASSERT_EQ(d.table(x, y), want[static_cast<std::size_t>(y) * s.width + x])
+                            << s.width << "x" << s.height << " set " << k << " round " << round << " at (" << x
+                            << ", " << y << ")";
+                        ++checked;
+                    }
+            }
+            computed += d.table_values_computed();
+            possible += d.refreshes() * static_cast<std::uint64_t>(s.pixels());
+        }
+    EXPECT_GT(lazy, full);
+    EXPECT_GT(full, 0u);
+    EXPECT_LT(computed, possible / 2) << "most values are never computed";
+    std::printf("incremental: %llu lazy and %llu full refreshes, %llu values compared, %llu of %llu computed\n",
+                static_cast<unsigned long long>(lazy), static_cast<unsigned long long>(full),
+                static_cast<unsigned long long>(checked), static_cast<unsigned long long>(computed),
+                static_cast<unsigned long long>(possible));
+}
+
 // ---------------------------------------------------------------- the detector vs the oracle
 
 // Events around drifting blobs, 0-3 us apart (about 1000 events per refresh_us = 1000),
@@ -454,10 +525,14 @@ TEST(LuvHarrisParams, OutOfRangeParametersThrowNamingThem) {
 TEST(LuvHarris, MemoryIsStateBytes) {
     for (const SensorSize s : {SensorSize{240, 180}, SensorSize{1280, 720}}) {
         EXPECT_EQ(LuvHarris(s).memory_bytes(), LuvHarris::state_bytes(s));
-        // The TOS (framed by 4) and the table dominate; the refresh's rings are small.
-        const std::uint64_t main = static_cast<std::uint64_t>(s.width + 8) * (s.height + 8) + 8u * s.pixels();
+        const LuvHarris original(s);
+        const LuvHarris copy(original);  // a copy holds the same buffers
+        EXPECT_EQ(copy.memory_bytes(), LuvHarris::state_bytes(s));
+        // The TOS (framed by 4) and its copy, the table and its stamps dominate; the
+        // refresh's rings and the tile marks are small.
+        const std::uint64_t main = 2u * static_cast<std::uint64_t>(s.width + 8) * (s.height + 8) + 12u * s.pixels();
         EXPECT_GE(LuvHarris::state_bytes(s), main);
-        EXPECT_LT(LuvHarris::state_bytes(s), main + 200u * (s.width + 8));
+        EXPECT_LT(LuvHarris::state_bytes(s), main + 200u * (s.width + 8) + s.pixels() / 7);  // 9 bytes per 8x8 tile
     }
 }
 

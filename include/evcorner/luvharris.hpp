@@ -19,6 +19,10 @@
 // tensor of integer derivative kernels summed over a block, computed in integers (exact,
 // k rounded to a multiple of 2^-16) and scaled to TOS levels per pixel. Same input, same
 // output on any machine: no clock, no thread, no floating-point contraction.
+// Cost: a refresh point keeps a copy of the TOS tiles (8x8) that events changed since the
+// previous one and marks the table values that depend on them as stale; a stale value is
+// computed from that copy when it is read (the same value the whole table would hold). A
+// refresh after many events (more than pixels / 3) computes the whole table at once.
 
 #include <cstddef>
 #include <cstdint>
@@ -67,7 +71,8 @@ public:
     /// message names it). `planes` is ignored: luvHarris ignores polarity.
     explicit LuvHarris(SensorSize size, const Params& params = {}, int planes = 2);
 
-    /// Bytes of state: the TOS, the table and the refresh's work buffers.
+    /// Bytes of state: the TOS and its copy at the latest refresh point, the table, its
+    /// stale marks and the refresh's work buffers.
     [[nodiscard]] static std::uint64_t state_bytes(SensorSize size, const Params& params = {}, int planes = 2) noexcept;
 
     [[nodiscard]] EventLimits limits() const noexcept { return {size_, -kMaxTime, kMaxTime}; }
@@ -83,14 +88,16 @@ public:
 
     /// Recomputes the table from the TOS now (what a refresh point does).
     void refresh() noexcept;
-    /// Refreshes done so far.
+    /// Refreshes done so far, and those of them that computed the whole table at once.
     [[nodiscard]] std::uint64_t refreshes() const noexcept { return refreshes_; }
+    [[nodiscard]] std::uint64_t full_refreshes() const noexcept { return full_refreshes_; }
+    /// Table values computed so far (a whole-table refresh counts every pixel).
+    [[nodiscard]] std::uint64_t table_values_computed() const noexcept { return computed_; }
 
-    /// The TOS value at (x, y) and the table value at (x, y) (unchecked).
+    /// The TOS value at (x, y) and the table value at (x, y) (unchecked; a stale value is
+    /// computed on this call, so the table reads as if recomputed whole at the latest refresh).
     [[nodiscard]] int tos(int x, int y) const noexcept { return tos_[index(x, y)]; }
-    [[nodiscard]] double table(int x, int y) const noexcept {
-        return table_[static_cast<std::size_t>(y) * static_cast<std::size_t>(size_.width) + static_cast<std::size_t>(x)];
-    }
+    [[nodiscard]] double table(int x, int y) const noexcept;
     /// The adaptive rule's running mean and variance of the looked-up values.
     [[nodiscard]] double running_mean() const noexcept { return mean_; }
     [[nodiscard]] double running_variance() const noexcept { return var_; }
@@ -108,6 +115,7 @@ private:
         return (static_cast<std::size_t>(y) + pad_) * stride_ + static_cast<std::size_t>(x) + pad_;
     }
     void update_tos(int x, int y) noexcept;
+    void mark_dirty(int x, int y) noexcept;
     void fill_border() noexcept;
 
     Params params_;
@@ -120,7 +128,20 @@ private:
     std::vector<std::int32_t> block_weights_;
 
     ZeroedArray<std::uint8_t> tos_;     // (height + 2 pad) x stride
-    ZeroedArray<double> table_;         // height x width
+    ZeroedArray<std::uint8_t> snap_;    // the TOS at the latest refresh point, same frame
+    // The table (height x width), valid where stamp_ or full_epoch_ is at least the pixel's
+    // tile's entry in stale_since_ (refresh epochs); computed on read elsewhere.
+    mutable ZeroedArray<double> table_;
+    mutable ZeroedArray<std::uint32_t> stamp_;
+    std::vector<std::uint32_t> stale_since_;   // per 8x8 tile of the table
+    std::vector<std::uint8_t> dirty_;          // per 8x8 tile of the TOS: changed since the refresh
+    ZeroedArray<std::uint32_t> dirty_list_;    // those tiles, in order of marking
+    std::size_t dirty_count_ = 0;
+    std::size_t tiles_w_ = 0;
+    std::uint32_t epoch_ = 0, full_epoch_ = 0;
+    std::uint64_t events_since_refresh_ = 0;
+    std::uint64_t full_refreshes_ = 0;
+    mutable std::uint64_t computed_ = 0;
     // Refresh work buffers (allocated once, a few rows each): ring buffers of the
     // horizontal smooth / derivative passes, one row of the three gradient products, a
     // ring of their horizontal block sums.
