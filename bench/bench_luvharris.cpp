@@ -3,7 +3,8 @@
 // Inputs: the eight Event-Camera-Dataset cuts (240x180) and expelliarmus/evt3_sample.raw
 // (Prophesee Gen4.1 EVT 3.0, 1280x720) under ../shared/data; without it, the bundled
 // shapes_translation sample only.
-// - refresh/<W>x<H>: one table refresh over a surface the file's events built;
+// - refresh/<W>x<H>: one refresh point over a surface the file's events built, with no event
+//   since the last (the incremental refresh then has nothing to copy: its fixed cost);
 // - events_only/<file>: every event with the table refreshed once before timing and never
 //   again (TOS update, look-up, adaptive threshold);
 // - full/<file>: the detector with its defaults (a refresh every 1000 us of event time),
