@@ -114,7 +114,7 @@ bool CsvReader::parse(const char* p, const char* end, Event& ev, const char*& wh
             }
             const detail::DecimalTime t = detail::parse_decimal_time(f, fe, unit, whole);
             if (t.error != nullptr) {
-                why = whole && unit_given_ && has_point && t.error != detail::kNotATimestamp
+                why = whole && unit_given_ && has_point && std::strcmp(t.error, detail::kNotATimestamp) != 0
                           ? (options_.keyword_spelling ? "a fraction of a microsecond, but time_unit is us (whole microseconds)"
                                                        : "a fraction of a microsecond, but --time-unit is us (whole microseconds)")
                           : t.error;

@@ -30,7 +30,7 @@ Parsed parse_line(const char* p, const char* end) {
     while (t_end < end && !is_space(*t_end)) ++t_end;
     const detail::DecimalTime t = detail::parse_decimal_time(p, t_end, TimeUnit::s, false);
     if (t.error != nullptr)
-        return {r.e, t.error == detail::kNotATimestamp ? "expected a timestamp in seconds" : t.error};
+        return {r.e, std::strcmp(t.error, detail::kNotATimestamp) == 0 ? "expected a timestamp in seconds" : t.error};
     r.e.t = t.us;
     p = t_end;
 
