@@ -115,7 +115,13 @@ inline bool parse_exponent_time(const char* b, const char* e, TimeUnit unit, boo
 }
 
 inline DecimalTime parse_decimal_time(const char* b, const char* e, TimeUnit unit, bool whole_only) noexcept {
-    if (DecimalTime x; parse_exponent_time(b, e, unit, whole_only, x)) return x;
+    const char* const start = b;
+    // Exponent notation is parsed apart; tried only where the plain reading stops (or would refuse).
+    const auto exponent = [&](const char* from, DecimalTime& x) {
+        for (const char* c = from; c < e; ++c)
+            if (*c == 'e' || *c == 'E') return parse_exponent_time(start, e, unit, whole_only, x);
+        return false;
+    };
     DecimalTime r;
     const auto is_digit = [](char c) { return static_cast<unsigned char>(c - '0') < 10; };
     bool negative = false;
@@ -125,7 +131,10 @@ inline DecimalTime parse_decimal_time(const char* b, const char* e, TimeUnit uni
     std::int64_t ip = 0;
     int int_digits = 0;
     while (b < e && is_digit(*b)) {
-        if (++int_digits > 18) return {0, false, "timestamp too large (at most 9e12 seconds)"};
+        if (++int_digits > 18) {
+            if (DecimalTime x; exponent(b, x)) return x;
+            return {0, false, "timestamp too large (at most 9e12 seconds)"};
+        }
         ip = ip * 10 + (*b++ - '0');
     }
     const int ns_digits = us_digits(unit) + 3;  // fraction digits down to a nanosecond
@@ -139,14 +148,17 @@ inline DecimalTime parse_decimal_time(const char* b, const char* e, TimeUnit uni
             const int d = *b - '0';
             if (d != 0) {
                 frac_nonzero = true;
-                if (frac_digits >= ns_digits)
+                if (frac_digits >= ns_digits) {
+                    if (DecimalTime x; exponent(b, x)) return x;
                     return {0, true, "a time given to a fraction of a nanosecond (more than 9 decimals of a second)"};
+                }
             }
             if (frac_digits < ns_digits) frac_ns = frac_ns * 10 + d;
             ++frac_digits;
             ++b;
         }
     }
+    if (DecimalTime x; b != e && (*b == 'e' || *b == 'E') && exponent(b, x)) return x;
     if (b != e || (int_digits == 0 && frac_digits == 0)) return {0, r.has_point, kNotATimestamp};
     if (whole_only && frac_nonzero)
         return {0, true, "a fraction of a microsecond in a time column of whole microseconds"};
