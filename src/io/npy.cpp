@@ -22,11 +22,17 @@ constexpr std::size_t kHeaderTotal = 192;  // fixed, a multiple of 64, room for 
 constexpr std::size_t kMaxHeaderLen = 1 << 16;
 
 std::string make_header(std::uint64_t count, bool with_score) {
-    std::string dict = fmt::format(
-        "{{'descr': [('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|u1'), ('_', '|V3'){}], "
-        "'fortran_order': False, 'shape': ({},), }}",
-        with_score ? ", ('score', '<f8')" : "", count);
+    return npy_header(fmt::format("[('t', '<i8'), ('x', '<u2'), ('y', '<u2'), ('p', '|u1'), ('_', '|V3'){}]",
+                                  with_score ? ", ('score', '<f8')" : ""),
+                      count);
+}
+
+}  // namespace
+
+std::string npy_header(std::string_view descr, std::uint64_t count) {
+    std::string dict = fmt::format("{{'descr': {}, 'fortran_order': False, 'shape': ({},), }}", descr, count);
     const std::size_t len = kHeaderTotal - 10;
+    if (dict.size() + 1 > len) throw std::logic_error("npy_header: the dtype does not fit the fixed header");
     dict.resize(len - 1, ' ');
     dict += '\n';
     std::string h(kMagic, 6);
@@ -36,8 +42,6 @@ std::string make_header(std::uint64_t count, bool with_score) {
     h += static_cast<char>(len >> 8);
     return h + dict;
 }
-
-}  // namespace
 
 namespace {
 std::string regular_file(std::string path) {

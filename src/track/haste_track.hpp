@@ -7,6 +7,7 @@
 // cell (i, j) at j * 31 + i), in float: the reference app's Eigen reductions sum in SIMD
 // lanes instead, which moves the last bits (docs/tracking.md, "Agreement").
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -105,7 +106,10 @@ struct HasteTrack {
     std::array<Hypothesis, kHasteHypotheses> hyp{};
     std::array<float, kHasteHypotheses> score{};
     std::array<float, kHasteCells> tmpl{};
-    // haste_correlation: the 11 x 193 samples, a ring per hypothesis like the window's.
+    // haste_correlation: the 11 x 193 samples, a ring of columns like the window's, each
+    // column the 11 hypotheses' samples of one event padded to 16 (the score sums over k
+    // for all hypotheses at once, each in k order).
+    static constexpr int kLanes = 16;
     std::vector<float> samples;
     // The normalised template of the last renewal (star methods); the difference
     // matrices D_n (haste_difference_star).
@@ -113,7 +117,7 @@ struct HasteTrack {
     std::vector<float> difference;
 
     HasteTrack() {
-        if constexpr (kStaleSamples) samples.assign(std::size_t{kHasteHypotheses} * 2 * kHasteWindow, 0.0f);
+        if constexpr (kStaleSamples) samples.assign(std::size_t{kLanes} * 2 * kHasteWindow, 0.0f);
         if constexpr (kNormalised) normalised.assign(kHasteCells, 0.0f);
         if constexpr (M == HasteMethod::haste_difference_star)
             difference.assign(std::size_t{kHasteHypotheses} * kHasteCells, 0.0f);
@@ -160,13 +164,12 @@ struct HasteTrack {
         int pos;
         const WindowEvent old = append(e, pos);
         if constexpr (kStaleSamples) {
+            float* col = samples.data() + std::size_t{kLanes} * pos;
             for (int n = 0; n < kHasteHypotheses; ++n) {
                 float px, py;
-                const float v = to_patch(hyp[n], e.x, e.y, px, py) ? sample_s(tmpl.data(), px, py) : 0.0f;
-                float* row = samples.data() + std::size_t{2 * kHasteWindow} * n;
-                row[pos] = v;
-                row[pos + kHasteWindow] = v;
+                col[n] = to_patch(hyp[n], e.x, e.y, px, py) ? sample_s(tmpl.data(), px, py) : 0.0f;
             }
+            std::copy(col, col + kLanes, col + std::size_t{kLanes} * kHasteWindow);
         }
         const WindowEvent middle = at(kHasteMiddle);
         update_scores(e, old);
@@ -221,15 +224,15 @@ struct HasteTrack {
     void renew() noexcept {
         make_hypotheses();
         if constexpr (kStaleSamples) {
-            for (int n = 0; n < kHasteHypotheses; ++n) {
-                float* row = samples.data() + std::size_t{2 * kHasteWindow} * n;
-                for (int k = 0; k < kHasteWindow; ++k) {
+            for (int k = 0; k < kHasteWindow; ++k) {
+                const int r = start + k;
+                float* col = samples.data() + std::size_t{kLanes} * r;
+                for (int n = 0; n < kHasteHypotheses; ++n) {
                     float px, py;
-                    const float v = to_patch(hyp[n], at(k).x, at(k).y, px, py) ? sample_v(tmpl.data(), px, py) : 0.0f;
-                    const int r = start + k;
-                    row[r] = v;
-                    row[r < kHasteWindow ? r + kHasteWindow : r - kHasteWindow] = v;
+                    col[n] = to_patch(hyp[n], at(k).x, at(k).y, px, py) ? sample_v(tmpl.data(), px, py) : 0.0f;
                 }
+                const int mirror = r < kHasteWindow ? r + kHasteWindow : r - kHasteWindow;
+                std::copy(col, col + kLanes, samples.data() + std::size_t{kLanes} * mirror);
             }
         }
         if constexpr (M == HasteMethod::haste_correlation_star) {
@@ -263,12 +266,11 @@ struct HasteTrack {
                 score[n] = s;
             }
         } else if constexpr (M == HasteMethod::haste_correlation) {
-            for (int n = 0; n < kHasteHypotheses; ++n) {
-                const float* row = samples.data() + std::size_t{2 * kHasteWindow} * n + start;
-                float s = 0;
-                for (int k = 0; k < kHasteWindow; ++k) s += row[k] * kHasteGaussianWeights[k];
-                score[n] = s;
-            }
+            alignas(64) float s[kLanes] = {};
+            const float* col = samples.data() + std::size_t{kLanes} * start;
+            for (int k = 0; k < kHasteWindow; ++k, col += kLanes)
+                for (int n = 0; n < kLanes; ++n) s[n] += col[n] * kHasteGaussianWeights[k];
+            std::copy(s, s + kHasteHypotheses, score.begin());
         } else if constexpr (M == HasteMethod::haste_correlation_star) {
             for (int n = 0; n < kHasteHypotheses; ++n) {
                 float px, py;

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "evcorner/io/binary_reader.hpp"
@@ -31,6 +32,11 @@
 #include "evcorner/io/output_file.hpp"
 
 namespace evcorner::io {
+
+/// The 192-byte header (format 1.0) of a one-dimensional C-order array of `count` records
+/// of dtype `descr` (a numpy descr literal, "[('t', '<i8'), ...]"): written first with a
+/// count of 0 and rewritten at close, in place.
+std::string npy_header(std::string_view descr, std::uint64_t count);
 
 class NpyWriter final : public EventWriter {
 public:
