@@ -31,6 +31,7 @@ from ._evcorner import (
 )
 from ._events import EventFile, Events, as_events, open, read, write  # noqa: A004 (open, like io.open)
 from ._detectors import DETECTOR_CLASSES, detect, detect_file, detectors, evaluate_truth, label, simulate
+from ._tracks import TRACK_DTYPE, TRACKERS, Tracker, track
 
 __version__ = "0.1.0"
 
@@ -49,6 +50,9 @@ __all__ = [
     "InvalidEvent",
     "OutputError",
     "StateTooLarge",
+    "TRACKERS",
+    "TRACK_DTYPE",
+    "Tracker",
     "as_events",
     "detect",
     "detect_file",
@@ -60,6 +64,7 @@ __all__ = [
     "read",
     "reduction_rate",
     "simulate",
+    "track",
     "write",
     *DETECTOR_CLASSES,
 ]

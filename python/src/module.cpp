@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "bindings.hpp"
 #include "evcorner/error.hpp"
 #include "evcorner/eval/feature_tracks.hpp"
 #include "evcorner/eval/metrics.hpp"
@@ -745,6 +746,8 @@ py::dict evaluate_truth_py(py::handle corners, const std::string& truth, double 
 
 }  // namespace
 
+std::span<const Event> evcorner::python::events_view(py::handle obj, const char* what) { return ::events_view(obj, what); }
+
 PYBIND11_MODULE(_evcorner, m) {
     m.doc() = "evcorner's C++ library (see the evcorner package for the documented API)";
 
@@ -879,6 +882,7 @@ PYBIND11_MODULE(_evcorner, m) {
     m.def("ft_percent", &eval::ft_percent, py::arg("n_corners"), py::arg("n_on_track"),
           "The feature-track percentage from two counts: 100 n_on_track / n_corners; 0 for no corners.");
     m.def("simulate", &simulate_py, py::arg("scene"), py::arg("is_path"));
+    python::export_tracks(m);
     m.def("evaluate_truth", &evaluate_truth_py, py::arg("corners"), py::arg("truth"), py::arg("radius"),
           py::arg("tolerance_us"), py::arg("credit"), py::arg("interpolation"), py::arg("speed_bins") = py::none());
 }
