@@ -11,6 +11,10 @@ from ._detectors import evaluate_truth as evaluate_truth
 from ._detectors import label as label
 from ._detectors import simulate as simulate
 from ._evcorner import EVENT_DTYPE as EVENT_DTYPE
+from ._tracks import TRACK_DTYPE as TRACK_DTYPE
+from ._tracks import TRACKERS as TRACKERS
+from ._tracks import Tracker as Tracker
+from ._tracks import track as track
 from ._evcorner import INPUT_FORMATS as INPUT_FORMATS
 from ._evcorner import OUTPUT_FORMATS as OUTPUT_FORMATS
 from ._evcorner import Detector as Detector

@@ -10,6 +10,8 @@ EVENT_DTYPE: np.dtype[np.void]
 INPUT_FORMATS: Tuple[str, ...]
 OUTPUT_FORMATS: Tuple[str, ...]
 READER_OPTION_KEYWORDS: Tuple[str, ...]
+TRACK_DTYPE: np.dtype[np.void]
+TRACKERS: List[Tuple[str, str]]
 
 Mask = npt.NDArray[np.uint8]
 Scores = npt.NDArray[np.float64]
@@ -116,3 +118,10 @@ def ft_percent(n_corners: int, n_on_track: int) -> float: ...
 def simulate(scene: str, is_path: bool) -> Tuple[Events, Tuple[int, int]]: ...
 def evaluate_truth(corners: Events, truth: str, radius: float, tolerance_us: int, credit: str, interpolation: str,
                    speed_bins: Optional[List[float]] = None) -> Dict[str, Any]: ...
+
+class Tracker:
+    def __init__(self, name: str, seeds: Optional[npt.NDArray[np.float64]], detector: Optional[str], init: str,
+                 width: int, height: int, seed_radius: float, max_tracks: int, max_idle_ms: Optional[float],
+                 min_separation: Optional[float]) -> None: ...
+    def process(self, events: Events) -> npt.NDArray[np.void]: ...
+    def stats(self) -> Dict[str, int]: ...
