@@ -237,5 +237,85 @@ TEST_F(CliRender, SpaceTimeDefaultsToAReadableWindow) {
     EXPECT_GE(drawn, 15'000);
 }
 
+// Two tracks over a handful of events, on a 240x180 sensor (a text file's default):
+// track 0 runs along row 30 from x = 20 to 60, track 1 down column 100 from y = 50 to 120,
+// at 10 ms steps. The figure is drawn at the last event, t = 1.05 s, with the default
+// 100 ms trail: track 0's sample at 0.9 s is too old, its sample at 1.2 s too new.
+TEST_F(CliRender, TracksKindDrawsEachTrackAsATrailInItsColour) {
+    write("ev.txt",
+          "1.000000 5 5 1\n"
+          "1.020000 200 150 0\n"
+          "1.050000 5 5 1\n");
+    write("tracks.txt",
+          "# id t x y\n"
+          "0 0.900000 20 150\n"
+          "0 1.010000 20 30\n"
+          "1 1.010000 100 50\n"
+          "0 1.020000 33.3 30\n"
+          "1 1.030000 100 85\n"
+          "0 1.030000 46.7 30\n"
+          "1 1.040000 100 120\n"
+          "0 1.040000 60 30\n"
+          "0 1.200000 200 30\n");
+    const auto bare = run("render ev.txt -k tracks --tracks tracks.txt --no-frame -o bare.png");
+    ASSERT_EQ(bare.status, 0) << bare.err;
+    EXPECT_NE(bare.err.find("trails of the last 100 ms, 2 tracks"), std::string::npos) << bare.err;
+    const RgbImage img = png("bare.png");
+    ASSERT_EQ(img.width(), 480);
+    ASSERT_EQ(img.height(), 360);
+    const render::Rgb c0 = render::track_colour(0), c1 = render::track_colour(1);
+    ASSERT_NE(c0, c1);
+    // Sensor pixel (x, y) is the 2x2 block at (2x, 2y); these look at its lower right.
+    auto at = [&](int x, int y) { return img.at(2 * x + 1, 2 * y + 1); };
+    for (int x = 20; x <= 60; x += 5) EXPECT_EQ(at(x, 30), c0) << "track 0 at x = " << x;
+    for (int y = 50; y <= 120; y += 10) EXPECT_EQ(at(100, y), c1) << "track 1 at y = " << y;
+    // The dots at the latest samples: 3x3 sensor pixels centred on them.
+    EXPECT_EQ(at(61, 31), c0);
+    EXPECT_EQ(at(99, 121), c1);
+    EXPECT_NE(at(58, 32), c0);  // beyond the dot
+    // Away from the trails: black, the events grey; nothing of the samples outside the window.
+    const render::Rgb black{0, 0, 0}, grey{150, 150, 150};
+    EXPECT_EQ(at(40, 80), black);
+    EXPECT_EQ(at(20, 100), black) << "the 0.9 s sample is older than the trail";
+    EXPECT_EQ(at(150, 30), black) << "the 1.2 s sample is after --at";
+    EXPECT_EQ(at(5, 5), grey);
+    EXPECT_EQ(at(200, 150), grey);
+
+    // The framed figure holds that one unchanged.
+    const auto framed = run("render ev.txt -k tracks --tracks tracks.txt -o out.png");
+    ASSERT_EQ(framed.status, 0) << framed.err;
+    ASSERT_TRUE(fs::exists(dir_ / "out.png"));
+    int bx = 0, by = 0;
+    EXPECT_TRUE(find_sub_image(png("out.png"), img, &bx, &by));
+
+    // --at and --window pick the window as for -k corners: (1.015 s, 1.025 s] holds track
+    // 0's sample of 1.02 s alone (a dot, no trail) and none of track 1's.
+    const auto narrow = run("render ev.txt -k tracks --tracks tracks.txt --no-frame --at 1.025 --window 10 -o n.png");
+    ASSERT_EQ(narrow.status, 0) << narrow.err;
+    EXPECT_NE(narrow.err.find("trails of the last 10 ms, 1 track"), std::string::npos) << narrow.err;
+    const RgbImage n = png("n.png");
+    EXPECT_EQ(n.at(2 * 33 + 1, 2 * 30 + 1), c0);
+    EXPECT_EQ(n.at(2 * 50 + 1, 2 * 30 + 1), black);
+    EXPECT_EQ(n.at(2 * 100 + 1, 2 * 50 + 1), black);
+}
+
+TEST_F(CliRender, TracksKindAndTracksOptionGoTogether) {
+    write("ev.txt", "1.000000 5 5 1\n1.050000 5 5 1\n");
+    write("tracks.txt", "0 1.01 20 30\n0 1.02 30 30\n");
+    const auto missing = run("render ev.txt -k tracks -o t.png");
+    EXPECT_EQ(missing.status, 2) << missing.err;
+    EXPECT_NE(missing.err.find("-k tracks needs --tracks FILE"), std::string::npos) << missing.err;
+    const auto other = run("render ev.txt -k corners --tracks tracks.txt -o t.png");
+    EXPECT_EQ(other.status, 2) << other.err;
+    EXPECT_NE(other.err.find("--tracks applies to -k tracks only (this is -k corners)"), std::string::npos)
+        << other.err;
+    const auto corners = run("render ev.txt -k tracks --tracks tracks.txt --corners ev.txt -o t.png");
+    EXPECT_EQ(corners.status, 2) << corners.err;
+    EXPECT_NE(corners.err.find("--corners applies to -k corners or space-time or labels only (this is -k tracks)"),
+              std::string::npos)
+        << corners.err;
+    EXPECT_FALSE(fs::exists(dir_ / "t.png"));
+}
+
 }  // namespace
 }  // namespace evcorner

@@ -4,6 +4,7 @@
 //   corners     Fig. 6:  events of the last 33 ms grey, corners of the last 33 / 100 ms
 //   space-time  Fig. 1b: events and corner events over an interval, time upwards
 //   labels      Fig. 5b: corner events in space-time, green on a feature track, red off
+//   tracks      the tracks of a track file (--tracks) as trails over the last 33 ms of events
 //
 // The input is streamed: every batch goes through the detector (its state needs the whole
 // past up to --at), and only the events and corner events the figure can draw are kept.
@@ -37,6 +38,7 @@
 #include "evcorner/render/figures.hpp"
 #include "evcorner/render/frame.hpp"
 #include "evcorner/state_memory.hpp"
+#include "evcorner/track/track_file.hpp"
 #include "progress.hpp"
 
 namespace evcorner::cli {
@@ -61,6 +63,7 @@ struct RenderOptions {
     std::string detector = "efast";
     ParamValues detector_params;
     std::string corners_file;
+    std::string tracks_file;
     std::string at;
     double window_ms = 0;  // 0: the kind's default
     int scale = 2;
@@ -128,6 +131,9 @@ Need need_for(const RenderOptions& o) {
         const render::RecentCornersStyle style;
         n.events_before = style.events_window_us;
         n.corners_before = w > 0 ? w : style.older_us;
+    } else if (o.kind == "tracks") {
+        n.events_before = render::TracksStyle{}.events_window_us;
+        n.corners = false;
     } else {
         n.auto_window = w == 0;
         n.events_before = w > 0 ? w : kAutoMaxUs;
@@ -203,7 +209,7 @@ void require_figure_fits(const RenderOptions& o, SensorSize size) {
     const auto w = static_cast<std::uint64_t>(size.width), h = static_cast<std::uint64_t>(size.height);
     const auto s = static_cast<std::uint64_t>(o.scale);
     std::uint64_t body_w = w * s, body_h = h * s, need = 0;
-    if (o.kind == "sae" || o.kind == "corners") {
+    if (o.kind == "sae" || o.kind == "corners" || o.kind == "tracks") {
         need = w * h * 3 + 2 * body_w * body_h * 3;
     } else {
         render::SpaceTimeStyle style;
@@ -345,7 +351,8 @@ render::FigureFormat check_output_name(const std::string& path) {
 void run_render(RenderOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
     const render::FigureFormat format = check_output_name(o.output);
-    io::check_output_paths({{"INPUT", o.input}, {"--corners", o.corners_file}}, {{"-o", o.output}});
+    io::check_output_paths({{"INPUT", o.input}, {"--corners", o.corners_file}, {"--tracks", o.tracks_file}},
+                           {{"-o", o.output}});
     io::check_outputs_creatable({{"-o", o.output}});
     if (!o.at.empty()) (void)parse_time_option(o.at, 0, 0);  // its syntax, before reading anything
     const Need need = need_for(o);
@@ -355,6 +362,9 @@ void run_render(RenderOptions& o) {
         throw std::invalid_argument("detector parameters given, but this figure runs no detector (" +
                                     std::string(from_file ? "--corners" : "-k " + o.kind) + ")");
     if (need.corners && !from_file) check_detector_config(DetectorConfig{o.detector, o.detector_params}, "--");
+    // The track file before the events: a malformed one fails before the stream is read.
+    std::vector<TrackPoint> tracks;
+    if (o.kind == "tracks") tracks = read_track_points(o.tracks_file);
     Kept k = stream_input(o, need, need.corners && !from_file);
     const std::int64_t at = k.at;
 
@@ -393,7 +403,7 @@ void run_render(RenderOptions& o) {
     std::string what;
     render::RgbImage img;                   // the figure alone (--no-frame)
     std::optional<render::Canvas> framed;  // the figure in its frame
-    if (o.kind == "sae" || o.kind == "corners") {
+    if (o.kind == "sae" || o.kind == "corners" || o.kind == "tracks") {
         render::RgbImage body;
         if (o.kind == "sae") {
             const std::string pol = o.polarity ? "ON" : "OFF";
@@ -403,7 +413,7 @@ void run_render(RenderOptions& o) {
             frame.grey_ramp = true;
             frame.ramp = {"age of the newest " + pol + " event:", "0", duration(window) + " or never"};
             what = fmt::format("at t = {}, fading over {}", seconds(at), duration(window));
-        } else {
+        } else if (o.kind == "corners") {
             render::RecentCornersStyle style;
             style.older_us = window = need.corners_before;
             body = render::upscale(render::render_recent_corners(events, corners, k.size, at, style), o.scale);
@@ -418,6 +428,27 @@ void run_render(RenderOptions& o) {
                             {render::kOffBright, "OFF corner, last " + recent},
                             {render::kOffDark, "OFF corner, " + recent + " to " + older}};
             what = fmt::format("at t = {}, corners of the last {}", seconds(at), older);
+        } else {
+            render::TracksStyle style;
+            style.scale = o.scale;
+            if (o.window_ms > 0) style.trail_us = window_us(o.window_ms);
+            window = style.trail_us;
+            body = render::render_tracks(events, tracks, k.size, at, style);
+            const std::vector<std::uint64_t> ids = render::drawn_track_ids(tracks, at, style);
+            const std::string trail = duration(window);
+            const std::string count = fmt::format("{} track{}", ids.size(), ids.size() == 1 ? "" : "s");
+            frame.title = {fmt::format("Feature tracks: {}", file),
+                           fmt::format("tracks from {}; t = {}", shown_name(o.tracks_file), seconds(at)),
+                           fmt::format("events of the last {}; trails of the last {}, a dot at each track's latest "
+                                       "sample; {}",
+                                       duration(style.events_window_us), trail, count)};
+            frame.legend = {{{150, 150, 150}, "event, last " + duration(style.events_window_us)}};
+            constexpr std::size_t kLegendTracks = 8;  // a legend for hundreds of tracks says nothing
+            for (std::size_t i = 0; i < ids.size() && i < kLegendTracks; ++i)
+                frame.legend.push_back({render::track_colour(ids[i]), fmt::format("track {}", ids[i])});
+            if (ids.size() > kLegendTracks)
+                frame.title.back() += fmt::format(" (legend: the first {})", kLegendTracks);
+            what = fmt::format("at t = {}, trails of the last {}, {}", seconds(at), trail, count);
         }
         if (o.no_frame)
             img = std::move(body);
@@ -477,27 +508,33 @@ void add_render_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "render",
         "Draw the paper's figures as PNG, SVG or PDF (by -o's extension): SAE, corners,\n"
-        "space-time view, labelled corners.\n"
+        "space-time view, labelled corners, feature tracks.\n"
         "Kinds: sae (Fig. 2b), corners (Fig. 6: events of the last 33 ms, corner events of the\n"
-        "last 33 ms bright and 100 ms dark, green ON / red OFF), space-time (Fig. 1b) and labels\n"
-        "(Fig. 5b: green on a feature track, red off it). Each figure gets a title (file,\n"
-        "detector, time and window), axes in sensor pixels (and time), and a legend; --no-frame\n"
-        "draws the figure alone. The input is streamed: memory follows the window drawn, not\n"
-        "the length of the input.");
+        "last 33 ms bright and 100 ms dark, green ON / red OFF), space-time (Fig. 1b), labels\n"
+        "(Fig. 5b: green on a feature track, red off it) and tracks (the tracks of --tracks FILE\n"
+        "over the events of the last 33 ms: each track's samples of the last 100 ms as a trail\n"
+        "in a colour per id, a dot at its latest). Each figure gets a title (file, detector,\n"
+        "time and window), axes in sensor pixels (and time), and a legend; --no-frame draws\n"
+        "the figure alone. The input is streamed: memory follows the window drawn, not the\n"
+        "length of the input.");
     cmd->add_option("INPUT", o->input, "Event file (any format evcorner reads)")->required();
     cmd->add_option("-o,--output", o->output, "Figure to write: .png, .svg or .pdf (the frame as vector graphics, the figure in it a "
                     "raster), or an existing device or FIFO (PNG)")->required();
-    cmd->add_option("-k,--kind", o->kind, "sae, corners, space-time or labels")
+    cmd->add_option("-k,--kind", o->kind, "sae, corners, space-time, labels or tracks")
         ->capture_default_str()
-        ->check(CLI::IsMember({"sae", "corners", "space-time", "labels"}));
+        ->check(CLI::IsMember({"sae", "corners", "space-time", "labels", "tracks"}));
     add_detector_option(*cmd, o->detector, "Detector for the corner events:" + detectors_help());
     add_param_options(*cmd, o->detector_params);
     cmd->add_option("--corners", o->corners_file, "Take the corner events from this file instead of detecting");
+    cmd->add_option("--tracks", o->tracks_file,
+                    "tracks: the track file to draw (what `evcorner track` writes: `id t x y`, haste, .csv "
+                    "or .npy; t in seconds on the events' clock, x y pixel indices)");
     cmd->add_option("--at", o->at,
                     "Time drawn (end of the interval): seconds on the stream's clock, +S after the first "
                     "event, -S before the last; it must lie within the stream [default: the last event]");
     cmd->add_option("--window", o->window_ms,
                     "Milliseconds, > 0: sae: age that fades to black [50]; corners: dark-corner span [100]; "
+                    "tracks: trail span [100]; "
                     "space-time/labels: interval before --at [the time the last 20 000 events before --at "
                     "span, rounded down to two significant digits, at most 500 ms]")
         ->check([](const std::string& s) {
@@ -524,7 +561,8 @@ void add_render_command(CLI::App& app) {
         "  evcorner render events.txt -k corners -o fig6.png --at +0.04\n"
         "  evcorner render events.txt -k labels -d harris -o fig5b.png\n"
         "  evcorner render events.txt -k sae --polarity 0 --window 30 -o sae.png\n"
-        "  evcorner render events.txt -k space-time -o fig1b.pdf           (for a paper)");
+        "  evcorner render events.txt -k space-time -o fig1b.pdf           (for a paper)\n"
+        "  evcorner render events.txt -k tracks --tracks tracks.txt -o tracks.png  (from evcorner track -d efast)");
     cmd->callback([o, cmd] {
         // An option that changes nothing in the figure asked for is a usage error.
         auto only_for = [&](const char* option, std::initializer_list<const char*> kinds) {
@@ -538,6 +576,10 @@ void add_render_command(CLI::App& app) {
                                         ")");
         };
         only_for("--polarity", {"sae"});
+        only_for("--tracks", {"tracks"});
+        if (o->kind == "tracks" && cmd->count("--tracks") == 0)
+            throw std::invalid_argument("-k tracks needs --tracks FILE: the track file to draw");
+        only_for("--corners", {"corners", "space-time", "labels"});
         only_for("--detector", {"corners", "space-time", "labels"});
         if (cmd->count("--detector") && cmd->count("--corners"))
             throw std::invalid_argument("--detector with --corners: the corner events come from the file, nothing is "

@@ -1,7 +1,9 @@
 #include "evcorner/render/figures.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -11,6 +13,46 @@ namespace {
 Rgb grey(int v) {
     const auto g = static_cast<std::uint8_t>(std::clamp(v, 0, 255));
     return {g, g, g};
+}
+
+// A track sample's time in microseconds, none where it cannot be one (|t| of 9e12 s and more).
+std::optional<std::int64_t> micros(double seconds) {
+    if (!(std::abs(seconds) < 9e12)) return std::nullopt;
+    return std::llround(seconds * 1e6);
+}
+
+// The sample's time in microseconds when render_tracks draws it: in (at - trail_us, at].
+std::optional<std::int64_t> drawn_time(const TrackPoint& p, std::int64_t at, const TracksStyle& s) {
+    const auto t = micros(p.t);
+    if (t && *t <= at && *t > at - s.trail_us) return t;
+    return std::nullopt;
+}
+
+// Liang-Barsky: the part of segment (x0, y0)-(x1, y1) inside [lo_x, hi_x] x [lo_y, hi_y],
+// in place; false when none of it is.
+bool clip_segment(double& x0, double& y0, double& x1, double& y1, double lo_x, double lo_y, double hi_x,
+                  double hi_y) noexcept {
+    const double dx = x1 - x0, dy = y1 - y0;
+    double a = 0, b = 1;
+    auto edge = [&](double p, double q) {
+        if (p == 0) return q >= 0;
+        const double r = q / p;
+        if (p < 0) {
+            if (r > b) return false;
+            a = std::max(a, r);
+        } else {
+            if (r < a) return false;
+            b = std::min(b, r);
+        }
+        return true;
+    };
+    if (!edge(-dx, x0 - lo_x) || !edge(dx, hi_x - x0) || !edge(-dy, y0 - lo_y) || !edge(dy, hi_y - y0)) return false;
+    const double sx = x0, sy = y0;
+    x0 = sx + a * dx;
+    y0 = sy + a * dy;
+    x1 = sx + b * dx;
+    y1 = sy + b * dy;
+    return true;
 }
 }  // namespace
 
@@ -111,6 +153,101 @@ RgbImage render_space_time(std::span<const Event> events, std::span<const Event>
         img.fill_square(u - side / 2, v - side / 2, side, colour);
     }
     return img;
+}
+
+Rgb track_colour(std::uint64_t id) noexcept {
+    // Tableau 10 without its grey (events are grey), with a yellow instead.
+    static constexpr std::array<Rgb, kTrackPaletteSize> palette{{{31, 119, 180},
+                                                                 {255, 127, 14},
+                                                                 {44, 160, 44},
+                                                                 {214, 39, 40},
+                                                                 {148, 103, 189},
+                                                                 {140, 86, 75},
+                                                                 {227, 119, 194},
+                                                                 {188, 189, 34},
+                                                                 {23, 190, 207},
+                                                                 {255, 221, 0}}};
+    return palette[id % palette.size()];
+}
+
+RgbImage render_tracks(std::span<const Event> events, std::span<const TrackPoint> tracks, SensorSize size,
+                       std::int64_t at, const TracksStyle& s) {
+    if (s.scale < 1 || s.line_width < 1 || s.dot_side < 1)
+        throw std::invalid_argument("tracks figure: scale, line width and dot side must be >= 1");
+    RgbImage sensor(size.width, size.height);
+    for (const Event& e : events)
+        if (e.t <= at && at - e.t < s.events_window_us) sensor.set(e.x, e.y, grey(150));
+    RgbImage img = upscale(sensor, s.scale);
+
+    struct Sample {
+        std::uint64_t id;
+        std::int64_t t;
+        double x, y;
+    };
+    std::vector<Sample> drawn;
+    for (const TrackPoint& p : tracks) {
+        if (const auto t = drawn_time(p, at, s)) drawn.push_back({p.id, *t, p.x, p.y});
+    }
+    std::stable_sort(drawn.begin(), drawn.end(),
+                     [](const Sample& a, const Sample& b) { return a.id != b.id ? a.id < b.id : a.t < b.t; });
+
+    // Sample coordinates far beyond any sensor (65535 px) are left out of the segments
+    // that reach them, so that nothing below overflows.
+    constexpr double kFar = 1e12;
+    auto usable = [&](const Sample& p) { return std::abs(p.x) < kFar && std::abs(p.y) < kFar; };
+    const double k = s.scale;
+    // Top-left of a square brush of side `side` image pixels centred on the sample: on the
+    // centre of its pixel, so a brush of one sensor pixel covers exactly that pixel's block,
+    // and a dot of 3 the 3x3 block Fig. 6 draws for a corner there.
+    auto corner_of = [&](double v, int side) { return (v + 0.5) * k - side / 2.0; };
+    auto pixel = [](double v) { return static_cast<int>(std::floor(v + 0.5)); };
+    const int line = s.line_width * s.scale, dot = s.dot_side * s.scale;
+    for (std::size_t i = 1; i < drawn.size(); ++i) {
+        const Sample &a = drawn[i - 1], &b = drawn[i];
+        if (a.id != b.id || !usable(a) || !usable(b)) continue;
+        double x0 = corner_of(a.x, line), y0 = corner_of(a.y, line), x1 = corner_of(b.x, line),
+               y1 = corner_of(b.y, line);
+        if (!clip_segment(x0, y0, x1, y1, -line - 1.0, -line - 1.0, img.width() + 1.0, img.height() + 1.0)) continue;
+        const Rgb c = track_colour(a.id);
+        // Bresenham over the brush's top-left, stamping the brush at every step.
+        int u0 = pixel(x0), v0 = pixel(y0);
+        const int u1 = pixel(x1), v1 = pixel(y1);
+        const int du = std::abs(u1 - u0), dv = -std::abs(v1 - v0);
+        const int su = u0 < u1 ? 1 : -1, sv = v0 < v1 ? 1 : -1;
+        int err = du + dv;
+        for (;;) {
+            img.fill_square(u0, v0, line, c);
+            if (u0 == u1 && v0 == v1) break;
+            const int e2 = 2 * err;
+            if (e2 >= dv) {
+                err += dv;
+                u0 += su;
+            }
+            if (e2 <= du) {
+                err += du;
+                v0 += sv;
+            }
+        }
+    }
+    // The dots last, on top of every trail.
+    for (std::size_t i = 0; i < drawn.size(); ++i) {
+        const Sample& p = drawn[i];
+        if ((i + 1 < drawn.size() && drawn[i + 1].id == p.id) || !usable(p)) continue;
+        const double x = corner_of(p.x, dot), y = corner_of(p.y, dot);
+        if (x < -dot || y < -dot || x > img.width() || y > img.height()) continue;
+        img.fill_square(pixel(x), pixel(y), dot, track_colour(p.id));
+    }
+    return img;
+}
+
+std::vector<std::uint64_t> drawn_track_ids(std::span<const TrackPoint> tracks, std::int64_t at,
+                                           const TracksStyle& style) {
+    std::vector<std::uint64_t> ids;
+    for (const TrackPoint& p : tracks)
+        if (drawn_time(p, at, style)) ids.push_back(p.id);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    return ids;
 }
 
 }  // namespace evcorner::render

@@ -9,13 +9,18 @@
 //   render_space_time     Fig. 1b / 5b: events and corner events over [t0, t1] in an oblique
 //                                  projection, time upwards; corners coloured by polarity, or
 //                                  by label (green on a feature track, red off it).
+//   render_tracks         feature tracks as trails over the events of the last 33 ms, one
+//                                  colour per track id, a dot at each track's latest sample.
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "evcorner/event.hpp"
 #include "evcorner/render/image.hpp"
 #include "evcorner/sensor.hpp"
+#include "evcorner/track_point.hpp"
 
 namespace evcorner::render {
 
@@ -67,5 +72,32 @@ SpaceTimeLayout space_time_layout(SensorSize size, const SpaceTimeStyle& style);
 RgbImage render_space_time(std::span<const Event> events, std::span<const Event> corners,
                            std::span<const std::uint8_t> labels, SensorSize size, std::int64_t t0,
                            std::int64_t t1, const SpaceTimeStyle& style = {});
+
+struct TracksStyle {
+    std::int64_t events_window_us = 33'000;  ///< grey events of (at - this, at], as in Fig. 6
+    std::int64_t trail_us = 100'000;         ///< track samples of (at - this, at] are drawn
+    int scale = 2;                           ///< image pixels per sensor pixel
+    int line_width = 1;                      ///< trail width, sensor pixels
+    int dot_side = 3;                        ///< side of the dot at a track's latest sample, sensor pixels
+};
+
+/// The colour of track `id`: a fixed palette of saturated colours (none grey), cycled by id.
+Rgb track_colour(std::uint64_t id) noexcept;
+/// How many colours track_colour cycles through.
+inline constexpr std::size_t kTrackPaletteSize = 10;
+
+/// Feature tracks on black, `style.scale` image pixels per sensor pixel: the events of
+/// (at - events_window_us, at] grey (as Fig. 6 draws them, then upscaled); for each track
+/// id, its samples of (at - trail_us, at] joined in time order (ties in the given order)
+/// by a line of track_colour(id), and a dot of that colour at the latest of them. A
+/// sample's (x, y) is in the pixel-index convention, the centre of sensor pixel (x, y):
+/// image point ((x + 0.5) scale, (y + 0.5) scale). Samples are in any order; their time is
+/// seconds on the events' clock. Throws std::invalid_argument for a scale, line width or
+/// dot side < 1.
+RgbImage render_tracks(std::span<const Event> events, std::span<const TrackPoint> tracks, SensorSize size,
+                       std::int64_t at, const TracksStyle& style = {});
+/// The ids render_tracks draws (those with a sample in (at - trail_us, at]), ascending, once each.
+std::vector<std::uint64_t> drawn_track_ids(std::span<const TrackPoint> tracks, std::int64_t at,
+                                           const TracksStyle& style = {});
 
 }  // namespace evcorner::render
