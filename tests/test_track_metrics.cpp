@@ -198,6 +198,32 @@ TEST(TrackMetrics, AssociationTakesTheNearestFreeGtTrackAtTheFirstTime) {
     EXPECT_DOUBLE_EQ(r.time_shift_s, 0.0);
 }
 
+TEST(TrackMetrics, SeedsMatchTracksWhereTheyWereSeededNotWhereTheyFirstReport) {
+    std::vector<TrackPoint> g = line_gt(0, 5);
+    const auto gt1 = line_gt(1, 50);
+    g.insert(g.end(), gt1.begin(), gt1.end());
+    // seeded at t = 0.1 on GT 1 (id 4) and on GT 0 (id 5); track 4 first reports at t = 0.2
+    // and ends at 0.3; id 6 has no seed.
+    const std::vector<TrackPoint> seeds = {{4, 0.1, 20, 50}, {5, 0.1, 20.5, 5}};
+    std::vector<TrackPoint> p = offset_track(4, {0, 0}, 2, 50);
+    const auto p5 = offset_track(5, {0, 0, 0, 0}, 1, 5);
+    p.insert(p.end(), p5.begin(), p5.end());
+    p.push_back({6, 0.1, 20, 50});
+    TrackMetricOptions o;
+    o.seeds = seeds;
+    const auto r = evaluate_tracks(p, g, o);
+    ASSERT_EQ(r.tracks.size(), 2u);
+    EXPECT_EQ(r.unmatched_tracks, 1u);
+    EXPECT_EQ(r.tracks[0].id, 4u);
+    EXPECT_EQ(r.tracks[0].gt_id, 1u);
+    EXPECT_EQ(r.tracks[1].gt_id, 0u);
+    // track 4: G = GT 1 from the seed's time, 0.1 .. 0.4, cut to 0.2 .. 0.3: fa = 0.1 / 0.3
+    // (from its first report, G would be 0.2 .. 0.4 and fa 0.5)
+    EXPECT_DOUBLE_EQ(r.tracks[0].age[4], (0.3 - 0.2) / (0.4 - 0.1));
+    EXPECT_DOUBLE_EQ(r.tracks[1].age[4], 1.0);
+    EXPECT_DOUBLE_EQ(r.time_shift_s, 0.0);
+}
+
 TEST(TrackMetrics, ResultsDoNotDependOnRowOrder) {
     std::vector<TrackPoint> g = line_gt(0);
     const auto gt1 = line_gt(1, 50);

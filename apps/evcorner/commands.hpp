@@ -17,6 +17,7 @@ void add_render_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_track_command(CLI::App& app);
+void add_eval_tracks_command(CLI::App& app);
 
 /// --format (the format table's names and aliases, io/formats.hpp) and every reader
 /// option of the table (io::reader_option_infos(): --csv-columns, --time-unit, --npy-columns,

@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
                      {"convert", evcorner::cli::add_convert_command}, {"label", evcorner::cli::add_label_command},
                      {"eval", evcorner::cli::add_eval_command},       {"render", evcorner::cli::add_render_command},
                      {"bench", evcorner::cli::add_bench_command},     {"simulate", evcorner::cli::add_simulate_command},
-                     {"track", evcorner::cli::add_track_command}};
+                     {"track", evcorner::cli::add_track_command},     {"eval-tracks", evcorner::cli::add_eval_tracks_command}};
     const auto named = std::find_if(std::begin(kCommands), std::end(kCommands),
                                     [&](const auto& c) { return argc > 1 && std::strcmp(argv[1], c.name) == 0; });
     for (const auto& c : kCommands)

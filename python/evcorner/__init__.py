@@ -31,7 +31,7 @@ from ._evcorner import (
 )
 from ._events import EventFile, Events, as_events, open, read, write  # noqa: A004 (open, like io.open)
 from ._detectors import DETECTOR_CLASSES, detect, detect_file, detectors, evaluate_truth, label, simulate
-from ._tracks import TRACK_DTYPE, TRACKERS, Tracker, track
+from ._tracks import TRACK_DTYPE, TRACKERS, Tracker, eval_tracks, track, track_statistics
 
 __version__ = "0.1.0"
 
@@ -57,6 +57,7 @@ __all__ = [
     "detect",
     "detect_file",
     "detectors",
+    "eval_tracks",
     "evaluate_truth",
     "ft_percent",
     "label",
@@ -65,6 +66,7 @@ __all__ = [
     "reduction_rate",
     "simulate",
     "track",
+    "track_statistics",
     "write",
     *DETECTOR_CLASSES,
 ]

@@ -14,6 +14,8 @@ from ._evcorner import EVENT_DTYPE as EVENT_DTYPE
 from ._tracks import TRACK_DTYPE as TRACK_DTYPE
 from ._tracks import TRACKERS as TRACKERS
 from ._tracks import Tracker as Tracker
+from ._tracks import eval_tracks as eval_tracks
+from ._tracks import track_statistics as track_statistics
 from ._tracks import track as track
 from ._evcorner import INPUT_FORMATS as INPUT_FORMATS
 from ._evcorner import OUTPUT_FORMATS as OUTPUT_FORMATS

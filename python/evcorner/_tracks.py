@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from . import _evcorner
@@ -47,3 +49,47 @@ def track(events, tracker="haste-correlation-star", *, seeds=None, detector=None
     """
     ev = events if getattr(events, "dtype", None) == _evcorner.EVENT_DTYPE else as_events(events)
     return Tracker(tracker, seeds=seeds, detector=detector, **kwargs).process(ev)
+
+
+def _points(tracks, what) -> np.ndarray:
+    """Track samples as an (N, 4) float array of id, t [s], x, y."""
+    if isinstance(tracks, (str, os.PathLike)):
+        return _evcorner.read_track_points(os.fspath(tracks))
+    a = np.asarray(tracks)
+    if a.dtype.names is not None:
+        missing = [f for f in ("id", "t", "x", "y") if f not in a.dtype.names]
+        if missing:
+            raise ValueError(f"{what}: a structured array needs fields id, t, x, y (missing {', '.join(missing)})")
+        t = a["t"]
+        # integer times are microseconds (TRACK_DTYPE), float times seconds
+        t = t / 1e6 if np.issubdtype(t.dtype, np.integer) else t.astype(float)
+        return np.column_stack([a["id"].astype(float), t, a["x"].astype(float), a["y"].astype(float)])
+    return a
+
+
+def eval_tracks(pred, gt, *, asynchronous=False, associate_px=None, seeds=None, align=True) -> dict:
+    """Predicted tracks against ground truth by the feature-track benchmark's metric.
+
+    pred, gt: track files (paths in any layout evcorner reads), TRACK_DTYPE arrays (what
+    track() returns), structured arrays with fields id, t, x, y (integer t in us, float t
+    in s), or (N, 4) arrays of id, t [s], x, y. Matched by id (the prediction's times first
+    shifted so that the first rows agree, unless align=False), by position within
+    associate_px at each track's first sample, or through seeds (where each track was
+    seeded: id, t, x, y in any of those forms; matched within associate_px, default 1 px).
+    asynchronous: the variant in which a track holds its last position instead of the GT
+    being cut.
+
+    Returns a dict: fa, efa, fa_5, te_5, inlier_ratio and age (per threshold 1..31 px),
+    their means and standard deviations, the track counts (predicted, gt, counted, skipped,
+    unmatched), time_shift_s and per-track results (docs/tracking.md).
+    """
+    return _evcorner.eval_tracks(_points(pred, "pred"), _points(gt, "gt"), bool(asynchronous),
+                                 0.0 if associate_px is None else float(associate_px),
+                                 None if seeds is None else _points(seeds, "seeds"), bool(align))
+
+
+def track_statistics(tracks) -> dict:
+    """What tracks say without ground truth: count, samples, lifetime and path length
+    (median, mean), jitter (RMS distance of each sample from the line between its
+    neighbours). tracks: as for eval_tracks."""
+    return _evcorner.track_statistics(_points(tracks, "tracks"))

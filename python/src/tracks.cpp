@@ -13,7 +13,9 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "evcorner/eval/track_metrics.hpp"
 #include "evcorner/registry.hpp"
+#include "evcorner/track/track_file.hpp"
 #include "evcorner/track/tracker.hpp"
 
 namespace py = pybind11;
@@ -117,6 +119,76 @@ private:
     std::unique_ptr<Tracker> tracker_;
 };
 
+/// Track samples from an (N, 4) float array of id, t [s], x, y.
+std::vector<TrackPoint> points_from(const py::object& obj, const char* what) {
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
+    if (!a || a.ndim() != 2 || a.shape(1) != 4)
+        throw py::value_error(std::string(what) + ": expected an (N, 4) array of id, t [s], x, y");
+    const auto r = a.unchecked<2>();
+    std::vector<TrackPoint> out;
+    out.reserve(static_cast<std::size_t>(a.shape(0)));
+    for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+        const double id = r(i, 0);
+        if (!(id >= 0) || id != std::floor(id) || id >= 1.8e19)
+            throw py::value_error(std::string(what) + ": row " + std::to_string(i) + ": id must be a whole number >= 0");
+        if (!std::isfinite(r(i, 1)) || !std::isfinite(r(i, 2)) || !std::isfinite(r(i, 3)))
+            throw py::value_error(std::string(what) + ": row " + std::to_string(i) + ": t, x and y must be finite");
+        out.push_back({static_cast<std::uint64_t>(id), r(i, 1), r(i, 2), r(i, 3)});
+    }
+    return out;
+}
+
+py::array points_array(const std::vector<TrackPoint>& pts) {
+    py::array_t<double> a(std::vector<py::ssize_t>{static_cast<py::ssize_t>(pts.size()), 4});
+    auto w = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        const auto k = static_cast<py::ssize_t>(i);
+        w(k, 0) = static_cast<double>(pts[i].id);
+        w(k, 1) = pts[i].t;
+        w(k, 2) = pts[i].x;
+        w(k, 3) = pts[i].y;
+    }
+    return a;
+}
+
+py::dict eval_tracks(const py::object& pred, const py::object& gt, bool asynchronous, double associate_px,
+                     const py::object& seeds, bool align) {
+    const std::vector<TrackPoint> p = points_from(pred, "pred"), g = points_from(gt, "gt");
+    std::vector<TrackPoint> sd;
+    if (!seeds.is_none()) sd = points_from(seeds, "seeds");
+    eval::TrackMetricOptions o;
+    o.asynchronous = asynchronous;
+    o.associate_px = associate_px;
+    o.align_start = align;
+    o.seeds = sd;
+    eval::TrackEvaluation r;
+    {
+        py::gil_scoped_release release;
+        r = eval::evaluate_tracks(p, g, o);
+    }
+    py::list tracks;
+    for (const eval::TrackScore& s : r.tracks)
+        tracks.append(py::dict(py::arg("id") = s.id, py::arg("gt_id") = s.gt_id, py::arg("skipped") = s.skipped,
+                               py::arg("fa_5") = s.skipped ? py::object(py::none()) : py::object(py::float_(s.age[4])),
+                               py::arg("te_5") = s.has_error_5 ? py::object(py::float_(s.error_5)) : py::object(py::none())));
+    return py::dict(py::arg("fa") = r.fa, py::arg("efa") = r.efa, py::arg("fa_5") = r.fa_5, py::arg("te_5") = r.te_5,
+                    py::arg("inlier_ratio") = r.inlier_ratio, py::arg("age") = r.age,
+                    py::arg("inlier_mean") = r.inlier_mean, py::arg("inlier_std") = r.inlier_std,
+                    py::arg("age_mean") = r.age_mean, py::arg("age_std") = r.age_std,
+                    py::arg("predicted_tracks") = r.predicted_tracks, py::arg("gt_tracks") = r.gt_tracks,
+                    py::arg("counted_tracks") = r.counted_tracks, py::arg("skipped_tracks") = r.skipped_tracks,
+                    py::arg("unmatched_tracks") = r.unmatched_tracks, py::arg("time_shift_s") = r.time_shift_s,
+                    py::arg("tracks") = tracks);
+}
+
+py::dict track_statistics(const py::object& tracks) {
+    const eval::TrackStatistics s = eval::track_statistics(points_from(tracks, "tracks"));
+    return py::dict(py::arg("tracks") = s.tracks, py::arg("samples") = s.samples,
+                    py::arg("lifetime_median_s") = s.lifetime_median_s, py::arg("lifetime_mean_s") = s.lifetime_mean_s,
+                    py::arg("length_median_px") = s.length_median_px, py::arg("length_mean_px") = s.length_mean_px,
+                    py::arg("jitter_rms_px") = s.jitter_rms_px, py::arg("jitter_samples") = s.jitter_samples);
+}
+
 }  // namespace
 
 void export_tracks(py::module_& m) {
@@ -132,6 +204,11 @@ void export_tracks(py::module_& m) {
              py::arg("min_separation"))
         .def("process", &PyTracker::process, py::arg("events"))
         .def("stats", &PyTracker::stats);
+    m.def("eval_tracks", &eval_tracks, py::arg("pred"), py::arg("gt"), py::arg("asynchronous"),
+          py::arg("associate_px"), py::arg("seeds"), py::arg("align"));
+    m.def("track_statistics", &track_statistics, py::arg("tracks"));
+    m.def("read_track_points", [](const std::string& path) { return points_array(read_track_points(path)); },
+          py::arg("path"));
 }
 
 }  // namespace evcorner::python

@@ -111,20 +111,51 @@ TrackScore score(const Track& g, Track p, const TrackMetricOptions& o) {
 TrackEvaluation evaluate_tracks(std::span<const TrackPoint> predicted, std::span<const TrackPoint> gt,
                                 const TrackMetricOptions& o) {
     TrackEvaluation r;
-    const bool by_id = !(o.associate_px > 0);
-    if (by_id && !predicted.empty() && !gt.empty() && predicted.front().t != gt.front().t)
+    const bool by_id = !(o.associate_px > 0) && o.seeds.empty();
+    if (by_id && o.align_start && !predicted.empty() && !gt.empty() && predicted.front().t != gt.front().t)
         r.time_shift_s = gt.front().t - predicted.front().t;
     const std::map<std::uint64_t, Track> pred = group(predicted, r.time_shift_s);
     const std::map<std::uint64_t, Track> truth = group(gt, 0);
     r.predicted_tracks = pred.size();
     r.gt_tracks = truth.size();
 
+    // Position-based matching: where and when each predicted track starts (its seed, or its
+    // first sample), taken in time order (then id), each the nearest free GT track in reach.
+    const bool by_seed = !o.seeds.empty();
+    std::map<std::uint64_t, Sample> start;
+    if (by_seed) {
+        for (const TrackPoint& p : o.seeds) start.emplace(p.id, Sample{p.t, p.x, p.y});
+    } else if (!by_id) {
+        for (const auto& [id, tr] : pred) start.emplace(id, tr.front());
+    }
+    std::vector<std::pair<std::uint64_t, Sample>> starts(start.begin(), start.end());
+    std::stable_sort(starts.begin(), starts.end(), [](const auto& a, const auto& b) { return a.second.t < b.second.t; });
+    const double radius = o.associate_px > 0 ? o.associate_px : 1.0;
+    std::map<std::uint64_t, std::pair<std::uint64_t, double>> matched;  // predicted id -> GT id, from time
+    std::map<std::uint64_t, bool> taken;
+    for (const auto& [id, first] : starts) {
+        double best = std::numeric_limits<double>::infinity();
+        std::uint64_t best_id = 0;
+        for (const auto& [gid, gtr] : truth) {
+            if (taken.count(gid) || gtr.front().t > first.t || gtr.back().t < first.t) continue;
+            const Sample q = at(gtr, first.t);
+            const double d = std::hypot(q.x - first.x, q.y - first.y);
+            if (d <= radius && d < best) {
+                best = d;
+                best_id = gid;
+            }
+        }
+        if (best <= radius) {
+            taken[best_id] = true;
+            matched[id] = {best_id, first.t};
+        }
+    }
+
     std::vector<std::pair<std::uint64_t, const Track*>> order;  // predicted tracks in evaluation order
     for (const auto& [id, tr] : pred) order.emplace_back(id, &tr);
-    if (!by_id)
+    if (!by_id && !by_seed)
         std::stable_sort(order.begin(), order.end(),
                          [](const auto& a, const auto& b) { return a.second->front().t < b.second->front().t; });
-    std::map<std::uint64_t, bool> taken;
     for (const auto& [id, tr] : order) {
         Track g;
         std::uint64_t gt_id = id;
@@ -136,26 +167,14 @@ TrackEvaluation evaluate_tracks(std::span<const TrackPoint> predicted, std::span
             }
             g = it->second;
         } else {
-            const Sample first = tr->front();
-            double best = std::numeric_limits<double>::infinity();
-            const Track* match = nullptr;
-            for (const auto& [gid, gtr] : truth) {
-                if (taken.count(gid) || gtr.front().t > first.t || gtr.back().t < first.t) continue;
-                const Sample q = at(gtr, first.t);
-                const double d = std::hypot(q.x - first.x, q.y - first.y);
-                if (d <= o.associate_px && d < best) {
-                    best = d;
-                    match = &gtr;
-                    gt_id = gid;
-                }
-            }
-            if (match == nullptr) {
+            const auto m = matched.find(id);
+            if (m == matched.end()) {
                 ++r.unmatched_tracks;
                 continue;
             }
-            taken[gt_id] = true;
-            for (const Sample& s : *match)
-                if (s.t >= first.t) g.push_back(s);
+            gt_id = m->second.first;
+            for (const Sample& q : truth.at(gt_id))
+                if (q.t >= m->second.second) g.push_back(q);
         }
         TrackScore s = score(g, *tr, o);
         s.id = id;

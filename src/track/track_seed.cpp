@@ -2,10 +2,13 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstring>
+#include <set>
 #include <string>
 
 #include "../io/decimal_time.hpp"
 #include "evcorner/io/line_source.hpp"
+#include "evcorner/track/track_file.hpp"
 
 namespace evcorner {
 
@@ -17,9 +20,33 @@ bool parse_real(const char* b, const char* e, double& v) {
     return r.ec == std::errc{} && r.ptr == e && std::isfinite(v);
 }
 
+// Whether the file's first line that is not blank (or a '#' comment) has no comma: a track
+// file in the `id t x y` layout rather than HASTE seeds.
+bool is_track_file(const std::string& path) {
+    io::LineSource src(path);
+    const char *b, *e;
+    while (src.next(b, e)) {
+        while (b < e && (*b == ' ' || *b == '\t')) ++b;
+        if (b == e || *b == '#') continue;
+        return std::memchr(b, ',', static_cast<std::size_t>(e - b)) == nullptr;
+    }
+    return false;
+}
+
+// Each track's first row, in the order tracks first appear.
+std::vector<TrackSeed> seeds_from_tracks(const std::string& path) {
+    std::vector<TrackSeed> seeds;
+    std::set<std::uint64_t> seen;
+    for (const TrackPoint& p : read_track_points(path))
+        if (seen.insert(p.id).second)
+            seeds.push_back({std::llround(p.t * 1e6), static_cast<float>(p.x), static_cast<float>(p.y), 0.0f, p.id});
+    return seeds;
+}
+
 }  // namespace
 
 std::vector<TrackSeed> read_seeds_file(const std::string& path) {
+    if (path != "-" && is_track_file(path)) return seeds_from_tracks(path);
     io::LineSource src(path);
     std::vector<TrackSeed> seeds;
     const char *b, *e;

@@ -23,14 +23,19 @@
 // Which GT track a predicted one is measured against:
 //   by id (the benchmark: predicted id k is the tracker seeded at GT track k's first sample);
 //     the prediction's times are first shifted by the GT file's first time minus its own
-//     (the benchmark aligns the files at their start; 0 when they already agree);
+//     (the benchmark aligns the files at their start; 0 when they already agree; off with
+//     align_start = false);
 //   by association (associate_px > 0; for trackers that seed themselves, such as a
 //     detector-seeded front end): predicted tracks in order of their first time (then id)
 //     each take the nearest GT track within associate_px of their first position at their
 //     first time (GT positions interpolated between its samples), among the GT tracks alive
 //     then and not taken yet; G is then that GT track from that time on (its rows at or after
 //     the predicted track's first time). No time shift. A predicted track with no GT track in
-//     reach is "unmatched" and counted nowhere.
+//     reach is "unmatched" and counted nowhere;
+//   by seed (seeds given; for a tracker seeded on GT positions at some time, as the HASTE
+//     goldens are): the same, from each seed's time and position instead of the predicted
+//     track's first sample (a tracker may first report later, and elsewhere); predicted id k
+//     is matched through seed k.
 
 #include <cstddef>
 #include <cstdint>
@@ -44,7 +49,13 @@ namespace evcorner::eval {
 struct TrackMetricOptions {
     bool asynchronous = false;
     double associate_px = 0;  ///< > 0: associate by position (above), else by id
+    /// By id: shift the prediction to the GT file's start (the benchmark's rule; off for
+    /// predictions on the GT's clock whose first report comes after the GT's first sample).
+    bool align_start = true;
     int max_threshold_px = 31;  ///< thresholds 1 .. this
+    /// Where the tracks were seeded (id, t, x, y): when given, tracks are matched by their
+    /// seeds (above), within associate_px (1 px when that is 0).
+    std::span<const TrackPoint> seeds;
 };
 
 /// One predicted track's result.

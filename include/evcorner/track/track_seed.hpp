@@ -19,7 +19,10 @@ struct TrackSeed {
 
 /// Seeds from a HASTE seeds file: whitespace-separated tokens `t,x,y,theta[,id]` (t in
 /// decimal seconds, read exactly to the microsecond; theta radians; id 0 when omitted).
-/// Throws io::InputError naming the file and line of a malformed token.
+/// A file whose first line has no comma is a track file (track_file.hpp: `id t x y` rows,
+/// such as ground-truth tracks): each track's first row seeds it, under its id, theta 0 (as
+/// the feature-track benchmark seeds a tracker at the GT's first samples).
+/// Throws InputError naming the file and line of a malformed token.
 std::vector<TrackSeed> read_seeds_file(const std::string& path);
 
 }  // namespace evcorner
