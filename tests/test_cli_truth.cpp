@@ -79,7 +79,7 @@ TEST_F(EvalTruthCli, PrecisionAndRecallAgreeWithTheOracle) {
 TEST_F(EvalTruthCli, SuiteFolderFindsEachTruthBesideItsEvents) {
     write("scene.json", kScene);
     fs::create_directories(dir_ / "suite");
-    ASSERT_EQ(run("simulate scene.json -o suite/a.events.npy --truth suite/a.truth.csv -q").status, 0);
+    ASSERT_EQ(run("simulate scene.json -o suite/a.events.npy --truth suite/a.truth.csv --gt-tracks suite/a.gt-tracks.txt -q").status, 0);
     ASSERT_EQ(run("simulate scene.json -o suite/b.events.txt --truth suite/b.truth.csv -q").status, 0);
     fs::copy_file(dir_ / "scene.json", dir_ / "suite/a.json");
     write("suite/manifest.json", "{}");
@@ -90,7 +90,7 @@ TEST_F(EvalTruthCli, SuiteFolderFindsEachTruthBesideItsEvents) {
     ASSERT_EQ(run("simulate suite/wide.json -o suite/wide.events.npy --truth suite/wide.truth.csv -q").status, 0);
     const CliResult r = run("eval suite -d efast --repeat 1 --no-progress --no-figures");
     ASSERT_EQ(r.status, 0) << r.err;
-    EXPECT_EQ(r.err.find("skipped"), std::string::npos) << r.err;  // truths, scenes and manifest are known
+    EXPECT_EQ(r.err.find("skipped"), std::string::npos) << r.err;  // truths, GT tracks, scenes and manifest are known
     // Both scenes, by their names, in the ground-truth table; the same events give the same row.
     const auto a = r.out.find("\na "), b = r.out.find("\nb ");
     ASSERT_NE(a, std::string::npos) << r.out;

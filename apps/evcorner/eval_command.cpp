@@ -118,10 +118,11 @@ std::string scene_sensor_beside(const Sequence& seq) {
     return fmt::format("{}x{}", j["sensor"][0].get<long long>(), j["sensor"][1].get<long long>());
 }
 
-// Files of a suite folder that are not event files: the truths, the scenes and the manifest.
+// Files of a suite folder that are not event files: the truths, the GT tracks, the scenes and
+// the manifest.
 bool is_suite_companion(const fs::path& p) {
     const std::string name = p.filename().string();
-    if (name.ends_with(".truth.csv") || name == "manifest.json") return true;
+    if (name.ends_with(".truth.csv") || name.ends_with(".gt-tracks.txt") || name == "manifest.json") return true;
     return p.extension() == ".json" && fs::is_regular_file(p.parent_path() / (p.stem().string() + ".truth.csv"));
 }
 
