@@ -41,8 +41,8 @@ struct TrackCommand {
 
 void print_summary(const TrackCommand& o, const pipeline::TrackSummary& t) {
     fmt::print(stderr, "evcorner track: {}\n", o.files.input == "-" ? "<stdin>" : o.files.input);
-    fmt::print(stderr, "  tracker      {} ({} start) on a {}x{} sensor\n", t.tracker, o.init, t.sensor.width,
-               t.sensor.height);
+    const std::string start = tracker_entry(t.tracker).takes_init ? " (" + o.init + " start)" : std::string();
+    fmt::print(stderr, "  tracker      {}{} on a {}x{} sensor\n", t.tracker, start, t.sensor.width, t.sensor.height);
     if (!t.detector.empty())
         fmt::print(stderr, "  seeds        corners of {}{}: {} corner events\n", t.detector, o.nms ? " after NMS" : "",
                    t.corners);
@@ -146,7 +146,8 @@ void add_track_command(CLI::App& app) {
                 return std::string(e.what());
             }
         });
-    cmd->add_option("--seeds", o->seeds, "Seeds file: whitespace-separated 't,x,y,theta[,id]' tokens (HASTE's layout)");
+    cmd->add_option("--seeds", o->seeds, "Seeds file: whitespace-separated 't,x,y,theta[,id]' tokens (HASTE's layout), or a track file "
+                    "of 'id t x y' rows (such as simulate --gt-tracks): each track's first row seeds it");
     add_detector_option(*cmd, o->detector, "Seed tracks from this detector's corner events:" + detectors_help());
     cmd->add_option("--init", o->init,
                     "How a track's first window of 193 events is filled: centered (96 before the seed, 97 from it; "

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "corner_tracker.hpp"
+
 namespace evcorner {
 
 namespace {
@@ -63,15 +65,19 @@ std::unique_ptr<Tracker> make_haste(SensorSize size, const TrackerConfig& c) {
 const TrackerEntry kTrackers[] = {
     {"haste-correlation-star",
      "HASTE (Alzugaray and Chli, BMVC 2020): normalised template, uniform weights, incremental; the fastest",
-     make_haste<HasteMethod::haste_correlation_star>},
+     make_haste<HasteMethod::haste_correlation_star>, true},
     {"haste-difference-star", "HASTE: squared difference to the window's model, incremental",
-     make_haste<HasteMethod::haste_difference_star>},
+     make_haste<HasteMethod::haste_difference_star>, true},
     {"haste-correlation", "HASTE: Gaussian-weighted correlation, each event sampled once",
-     make_haste<HasteMethod::haste_correlation>},
+     make_haste<HasteMethod::haste_correlation>, true},
     {"haste-difference", "HASTE: squared difference to the window's model, recomputed per event",
-     make_haste<HasteMethod::haste_difference>},
+     make_haste<HasteMethod::haste_difference>, true},
     {"correlation", "multi-hypothesis tracker (Alzugaray and Chli, 3DV 2019): Gaussian correlation, recomputed per event",
-     make_haste<HasteMethod::correlation>},
+     make_haste<HasteMethod::correlation>, true},
+    {"corners",
+     "corner events alone: each updates the nearest live track within --seed-radius (constant-velocity "
+     "alpha-beta filter); far cheaper, for when every corner is a measurement",
+     detail::make_corner_tracker},
 };
 
 }  // namespace

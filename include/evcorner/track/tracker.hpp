@@ -59,6 +59,7 @@ struct TrackerEntry {
     std::string_view name;     ///< on the command line
     std::string_view summary;  ///< one line for --help
     std::unique_ptr<Tracker> (*make)(SensorSize, const TrackerConfig&);
+    bool takes_init = false;   ///< TrackerConfig::init applies (a patch tracker's start)
 };
 
 /// THE list, in the order --help gives it.
