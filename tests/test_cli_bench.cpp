@@ -11,6 +11,7 @@
 
 #include "cli_test_util.hpp"
 #include "evcorner/registry.hpp"
+#include "evcorner/track/tracker.hpp"
 
 namespace evcorner {
 namespace {
@@ -137,6 +138,79 @@ TEST_F(CliBench, UnknownDetectorIsAUsageError) {
     const Result r = run("bench '" + sample_.string() + "' -d nope --min-events 10");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("nope"), std::string::npos) << r.err;
+}
+
+// Three seeds on the sample's shapes (HASTE's 't,x,y,theta,id' tokens, t in seconds), at
+// corner events eFAST finds there.
+constexpr const char* kSampleSeeds = "51.983,61,109,0,0\n51.983,17,103,0,1\n52.0,104,36,0,2\n";
+
+TEST_F(CliBench, TimesEveryTrackerBesideEfast) {
+    write("seeds.txt", kSampleSeeds);
+    const Result r = run("bench '" + sample_.string() + "' --tracker all --seeds seeds.txt --init uncentered "
+                         "--repeat 2 --json b.json -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const char* what : {"CPU", "ns/event", "ns/update", "x efast", "live"})
+        EXPECT_NE(r.out.find(what), std::string::npos) << what << " missing from:\n" << r.out;
+    // One row per registered tracker (all of them, any added since included), in the
+    // registry's order; no detector rows.
+    const auto j = nlohmann::json::parse(slurp(dir_ / "b.json"));
+    EXPECT_TRUE(j["results"].empty());
+    EXPECT_EQ(j["init"], "uncentered");
+    ASSERT_EQ(j["trackers"].size(), tracker_registry().size());
+    std::size_t with_updates = 0;
+    for (std::size_t i = 0; i < tracker_registry().size(); ++i) {
+        const auto& x = j["trackers"][i];
+        const std::string name(tracker_registry()[i].name);
+        EXPECT_EQ(x["tracker"], name);
+        EXPECT_NE(r.out.find(name), std::string::npos) << name << " missing from:\n" << r.out;
+        EXPECT_EQ(x["events"].get<std::uint64_t>(), 30000u) << name;
+        EXPECT_EQ(x["tracks_started"].get<std::uint64_t>(), 3u) << name;
+        EXPECT_EQ(x["ns_per_event"].size(), 2u) << name;
+        EXPECT_EQ(x["efast_ns_per_event"].size(), 2u) << name;
+        EXPECT_GT(x["efast_ns_per_event_median"].get<double>(), 0.0) << name;
+        EXPECT_GT(x["efast_ratio_median"].get<double>(), 0.0) << name;
+        for (std::size_t k = 0; k < 2; ++k)  // the ratio is per round, to that round's eFAST pass
+            EXPECT_DOUBLE_EQ(x["efast_ratio"][k].get<double>(),
+                             x["ns_per_event"][k].get<double>() / x["efast_ns_per_event"][k].get<double>())
+                << name;
+        if (x["updates"].get<std::uint64_t>() > 0) {
+            ++with_updates;
+            EXPECT_GT(x["ns_per_update_median"].get<double>(), 0.0) << name;
+            EXPECT_EQ(x["ns_per_update"].size(), 2u) << name;
+        } else {
+            EXPECT_TRUE(x["ns_per_update_median"].is_null()) << name;
+        }
+    }
+    EXPECT_GT(with_updates, 0u);  // the HASTE trackers meet events around the seeds
+    // eFAST is timed once per round, the same figure in every row of the input.
+    EXPECT_EQ(j["trackers"][0]["efast_ns_per_event"], j["trackers"].back()["efast_ns_per_event"]);
+}
+
+TEST_F(CliBench, TrackerSeededByADetector) {
+    const Result r = run("bench '" + sample_.string() + "' --tracker " + std::string(tracker_registry()[0].name) +
+                         " -d efast --repeat 1 --json b.json -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "b.json"));
+    ASSERT_EQ(j["trackers"].size(), 1u);
+    EXPECT_EQ(j["seeding"], "corners of efast");
+    EXPECT_GT(j["trackers"][0]["corners"].get<std::uint64_t>(), 0u);
+    EXPECT_GT(j["trackers"][0]["tracks_started"].get<std::uint64_t>(), 0u);
+    // One detector seeds: a list is a usage error, and so are both seedings or none.
+    write("seeds.txt", kSampleSeeds);
+    for (const char* bad : {" -d efast,harris", " -d efast --seeds seeds.txt", ""}) {
+        const Result b = run("bench '" + sample_.string() + "' --tracker all --repeat 1 -q" + bad);
+        EXPECT_EQ(b.status, 2) << bad;
+    }
+}
+
+TEST_F(CliBench, UnknownTrackerIsAUsageError) {
+    write("seeds.txt", kSampleSeeds);
+    const Result r = run("bench '" + sample_.string() + "' --tracker nope --seeds seeds.txt --repeat 1");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("nope"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(tracker_registry()[0].name), std::string::npos) << "names the trackers there are:\n" << r.err;
+    const Result seeds_alone = run("bench '" + sample_.string() + "' --seeds seeds.txt --min-events 10");
+    EXPECT_EQ(seeds_alone.status, 2);
 }
 
 TEST_F(CliBench, DetectThreadsGivesIdenticalOutputs) {

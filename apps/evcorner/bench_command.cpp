@@ -35,6 +35,14 @@
 // compiled with the same compiler and flags; per input and detector the ratio of its cold
 // ns/event to the detector's cold ns/event (how many times faster than the yardstick), and the
 // median of those ratios over the inputs.
+// --tracker NAME (repeatable; all = every registered tracker): the trackers instead of the
+// detectors, seeded as `evcorner track` seeds them (--seeds FILE, or the corners of the one
+// detector -d names). --repeat rounds over each input as it is (no replay); in each, eFAST
+// detect (fresh, timed with steady_clock) and then every tracker once through
+// pipeline::run_track (a fresh tracker; the pipeline times the tracker's calls alone, by
+// steady_clock). Per tracker: ns per event, ns per in-range (event, track) update
+// (TrackerStats::updates), live tracks, and its ns per event over eFAST's in the same round;
+// medians over the rounds.
 // Data flows one way: the timing wraps the loop; the detectors know nothing of it.
 
 #include <algorithm>
@@ -62,7 +70,9 @@
 #include "evcorner/detector.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
+#include "evcorner/pipeline/track.hpp"
 #include "evcorner/state_memory.hpp"
+#include "evcorner/track/tracker.hpp"
 #include "evcorner/parallel_detect.hpp"
 #include "bench_command_yardstick.hpp"
 #include "progress.hpp"
@@ -96,6 +106,11 @@ struct BenchOptions {
     bool cpu_time = false;
     bool quiet = false;
     bool no_progress = false;
+    // Trackers (--tracker): timed instead of the detectors, seeded from --seeds or -d.
+    std::vector<std::string> trackers;
+    std::string seeds;
+    std::string init = "centered";
+    bool detectors_given = false;  // -d on the command line (the default lists every detector)
 };
 
 struct Row {
@@ -124,6 +139,18 @@ struct ColdRuns {
     std::uint64_t yardstick_corners = 0;
     std::vector<std::vector<double>> ns;  // per detector, per round
     std::vector<std::uint64_t> corners;   // per detector
+};
+
+// One tracker on one input: --repeat rounds, each one pass over the file beside eFAST's.
+struct TrackerRow {
+    std::string input;
+    std::string tracker;
+    SensorSize sensor;
+    std::uint64_t events = 0;
+    std::uint64_t corners = 0;  // the seeding detector's, with -d
+    TrackerStats stats;         // of the last round (every round does the same work)
+    std::vector<double> ns_per_event, ns_per_update, efast_ns_per_event, efast_ratio;  // per round
+    double median_event = 0, median_update = 0, median_efast = 0, median_ratio = 0;
 };
 
 // ----------------------------------------------------------------- machine description
@@ -387,6 +414,131 @@ Row bench_parallel(const std::string& input, const std::string& name, int thread
     });
 }
 
+// ----------------------------------------------------------------- trackers
+
+/// A loaded input handed to the tracking pipeline (pipeline::run_track) as a file reader
+/// would hand it: batches of events, nothing skipped.
+class MemoryReader final : public io::EventReader {
+public:
+    MemoryReader(std::span<const Event> events, SensorSize sensor, const std::string& name)
+        : events_(events), sensor_(sensor), name_(name) {}
+    std::size_t read(std::span<Event> out) override {
+        const std::size_t n = std::min(out.size(), events_.size() - next_);
+        std::copy_n(events_.begin() + static_cast<std::ptrdiff_t>(next_), n, out.begin());
+        next_ += n;
+        return n;
+    }
+    [[nodiscard]] std::span<const io::SkipRun> skipped_in_batch() const noexcept override { return {}; }
+    [[nodiscard]] std::uint64_t skipped() const noexcept override { return 0; }
+    [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
+    [[nodiscard]] std::string_view format() const noexcept override { return "memory"; }
+    [[nodiscard]] const std::string& name() const noexcept override { return name_; }
+    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return next_ * sizeof(Event); }
+    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override {
+        return events_.size() * sizeof(Event);
+    }
+
+private:
+    std::span<const Event> events_;
+    std::size_t next_ = 0;
+    SensorSize sensor_;
+    std::string name_;
+};
+
+/// --tracker's names, "all" expanded to every registered tracker, each once, in order;
+/// throws std::invalid_argument for an unknown one (naming the trackers there are).
+std::vector<std::string> parse_tracker_list(const std::vector<std::string>& names) {
+    std::vector<std::string> out;
+    auto add = [&](std::string_view n) {
+        if (std::find(out.begin(), out.end(), n) == out.end()) out.emplace_back(n);
+    };
+    for (const std::string& n : names) {
+        if (n == "all") {
+            for (const TrackerEntry& t : tracker_registry()) add(t.name);
+            continue;
+        }
+        try {
+            (void)tracker_entry(n);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(std::string("--tracker: ") + e.what());
+        }
+        add(n);
+    }
+    if (out.empty()) throw std::invalid_argument("--tracker: no tracker named");
+    return out;
+}
+
+/// What `evcorner track` would run for `tracker` with these seeds (--seeds), or seeded from
+/// the corners of -d's one detector with that command's front-end stopping rules.
+pipeline::TrackOptions track_options(const BenchOptions& o, const std::string& tracker,
+                                     const std::vector<TrackSeed>& seeds, const std::string& seed_detector) {
+    pipeline::TrackOptions t;
+    t.tracker = tracker;
+    t.config.init = o.init == "centered" ? HasteInit::centered : HasteInit::uncentered;
+    if (seed_detector.empty()) {
+        t.config.seeds = seeds;
+    } else {
+        pipeline::DetectOptions d;
+        d.detector = config_for(seed_detector, o.detector_params);
+        d.param_prefix = "--";
+        t.detect = d;
+        t.config.stop.max_idle_us = 200000;  // evcorner track -d's defaults (docs/tracking.md, "Front end")
+        t.config.stop.min_separation = 3;
+    }
+    pipeline::check_track_options(t);
+    return t;
+}
+
+/// --repeat rounds over the file as it is; in each, eFAST detect (a fresh detector; the
+/// reference of the ratio) and then every tracker once through pipeline::run_track, which
+/// times the tracker's calls alone (steady_clock; with -d the detector in front is not in it).
+/// eFAST is timed by the same clock.
+std::vector<TrackerRow> tracker_runs(const std::string& input, const std::vector<Event>& file, SensorSize sensor,
+                                     const std::vector<pipeline::TrackOptions>& runs, const BenchOptions& o,
+                                     const PassDone& done) {
+    std::vector<TrackerRow> rows(runs.size());
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        rows[i].input = input;
+        rows[i].tracker = runs[i].tracker;
+        rows[i].sensor = sensor;
+    }
+    std::vector<std::uint8_t> flags(file.size());
+    const double n = static_cast<double>(file.size());
+    const auto discard = [](std::span<const TrackState>) {};
+    for (int r = 0; r < o.repeat; ++r) {
+        double efast_ns = 0;
+        AnyDetector efast = make_detector(DetectorConfig{"efast", {}}, sensor, "--");
+        std::visit(
+            [&](auto& det) {
+                const double t0 = bench_clock_ns(false);
+                (void)detect(det, std::span<const Event>(file), flags);
+                efast_ns = (bench_clock_ns(false) - t0) / n;
+            },
+            efast);
+        done(file.size());
+        for (std::size_t i = 0; i < runs.size(); ++i) {
+            MemoryReader reader(file, sensor, input);
+            const pipeline::TrackSummary t = pipeline::run_track(reader, runs[i], discard, sensor);
+            TrackerRow& row = rows[i];
+            row.events = t.events;
+            row.corners = t.corners;
+            row.stats = t.stats;
+            row.ns_per_event.push_back(t.ns_per_event());
+            if (t.stats.updates > 0) row.ns_per_update.push_back(t.ns_per_update());
+            row.efast_ns_per_event.push_back(efast_ns);
+            row.efast_ratio.push_back(efast_ns > 0 ? t.ns_per_event() / efast_ns : 0.0);
+            done(file.size());
+        }
+    }
+    for (TrackerRow& row : rows) {
+        row.median_event = median_of(row.ns_per_event);
+        row.median_update = median_of(row.ns_per_update);  // 0: no update in range
+        row.median_efast = median_of(row.efast_ns_per_event);
+        row.median_ratio = median_of(row.efast_ratio);
+    }
+    return rows;
+}
+
 // ----------------------------------------------------------------- report
 
 std::string short_name(const std::string& path) {
@@ -529,6 +681,146 @@ void write_json(const std::string& path, const std::vector<Row>& rows, const std
     out.close();
 }
 
+void print_tracker_table(std::FILE* out, const std::vector<TrackerRow>& rows, bool with_corners) {
+    fmt::print(out, "{:<34} {:<23} {:>10} {:>8} {:>6} {:>12} {:>9} {:>9} {:>8} {:>8}\n", "input", "tracker", "events",
+               "started", "live", "updates", "ns/event", "ns/update", "efast", "x efast");
+    fmt::print(out, "{:<34} {:<23} {:>10} {:>8} {:>6} {:>12} {:>19} {:>8} {:>8}\n", "", "", "", "tracks", "", "in range",
+               "tracking, median", "ns/event", "ns/event");
+    for (const TrackerRow& r : rows) {
+        fmt::print(out, "{:<34} {:<23} {:>10} {:>8} {:>6} {:>12} {:>9.1f}", short_name(r.input), r.tracker, r.events,
+                   r.stats.started, r.stats.live, r.stats.updates, r.median_event);
+        if (r.median_update > 0)
+            fmt::print(out, " {:>9.1f}", r.median_update);
+        else
+            fmt::print(out, " {:>9}", "-");
+        fmt::print(out, " {:>8.1f} {:>8.2f}\n", r.median_efast, r.median_ratio);
+    }
+    if (with_corners && !rows.empty())
+        fmt::print(out, "(seeding detector: {} corner events on {})\n", rows.front().corners, short_name(rows.front().input));
+}
+
+void write_tracker_json(const std::string& path, const std::vector<TrackerRow>& rows, const std::string& cpu,
+                        const BenchOptions& o, const std::string& seeding) {
+    nlohmann::json j;
+    j["cpu"] = cpu;
+    j["compiler"] = compiler();
+    j["build_type"] = EVCORNER_BUILD_TYPE;
+    j["build_flags"] = EVCORNER_BUILD_FLAGS;
+    j["efast_code_path"] = efast_code_path();
+    j["repeat"] = o.repeat;
+    j["clock"] = "steady_clock";
+    j["seeding"] = seeding;
+    j["init"] = o.init;
+    j["results"] = nlohmann::json::array();  // no detector rows with --tracker
+    j["trackers"] = nlohmann::json::array();
+    for (const TrackerRow& r : rows) {
+        nlohmann::json x;
+        x["input"] = r.input;
+        x["tracker"] = r.tracker;
+        x["width"] = r.sensor.width;
+        x["height"] = r.sensor.height;
+        x["events"] = r.events;
+        x["corners"] = r.corners;
+        x["tracks_started"] = r.stats.started;
+        x["tracks_initialised"] = r.stats.initialised;
+        x["seeds_skipped"] = r.stats.skipped_seeds;
+        x["live"] = r.stats.live;
+        x["updates"] = r.stats.updates;
+        x["ns_per_event"] = r.ns_per_event;
+        x["ns_per_event_median"] = r.median_event;
+        x["ns_per_update"] = r.ns_per_update;
+        x["ns_per_update_median"] = r.median_update > 0 ? nlohmann::json(r.median_update) : nlohmann::json(nullptr);
+        x["efast_ns_per_event"] = r.efast_ns_per_event;
+        x["efast_ns_per_event_median"] = r.median_efast;
+        x["efast_ratio"] = r.efast_ratio;
+        x["efast_ratio_median"] = r.median_ratio;
+        j["trackers"].push_back(std::move(x));
+    }
+    io::OutputFile out(path);
+    out.write(j.dump(2));
+    out.write("\n");
+    out.close();
+}
+
+/// evcorner bench --tracker: the trackers instead of the detectors, each beside eFAST detect.
+void run_tracker_bench(const BenchOptions& o) {
+    std::FILE* const out = o.json == "-" ? stderr : stdout;
+    const std::vector<std::string> trackers = parse_tracker_list(o.trackers);
+    if (o.threads != "1") throw std::invalid_argument("--threads: trackers run on one thread; drop --threads with --tracker");
+    if (o.yardstick) throw std::invalid_argument("--yardstick: not with --tracker (the tracker rows have eFAST's ratio)");
+    if (o.cpu_time)
+        throw std::invalid_argument("--cpu-time: not with --tracker (the tracking pipeline times the tracker's calls "
+                                    "by steady_clock)");
+    // Seeds from a file, or the corners of the one detector -d names (as evcorner track).
+    if (o.seeds.empty() == !o.detectors_given)
+        throw std::invalid_argument("--tracker: give exactly one of --seeds FILE and -d DETECTOR (the detector whose "
+                                    "corners seed the tracks, as in evcorner track)");
+    std::string seed_detector, seeding;
+    std::vector<TrackSeed> seeds;
+    if (o.detectors_given) {
+        const std::vector<std::string> d = parse_detector_list(o.detectors);
+        if (d.size() != 1)
+            throw std::invalid_argument("-d: with --tracker, one detector, whose corners seed the tracks; got '" +
+                                        o.detectors + "'");
+        seed_detector = d.front();
+        check_params_taken(d, o.detector_params, "--");
+        check_detector_config(config_for(seed_detector, o.detector_params), "--");
+        seeding = "corners of " + seed_detector;
+    } else {
+        seeds = read_seeds_file(o.seeds);
+        if (seeds.empty()) throw std::invalid_argument("--seeds: " + o.seeds + " holds no seed");
+        seeding = fmt::format("{} seeds from {}", seeds.size(), o.seeds);
+    }
+    std::vector<pipeline::TrackOptions> runs;
+    for (const std::string& t : trackers) runs.push_back(track_options(o, t, seeds, seed_detector));
+
+    const std::string cpu = cpu_model();
+    std::string names;
+    for (const std::string& t : trackers) names += (names.empty() ? "" : ",") + t;
+    fmt::print(out, "evcorner bench: {} input(s), trackers {}, {} round(s) each\n", o.inputs.size(), names, o.repeat);
+    fmt::print(out, "CPU      {}\n", cpu);
+    fmt::print(out, "build    {} build, {}, flags: {}; eFAST code path: {}\n", EVCORNER_BUILD_TYPE, compiler(),
+               EVCORNER_BUILD_FLAGS, efast_code_path());
+    fmt::print(out, "method   one thread; per round, eFAST detect and then each tracker once over each file as it is\n"
+               "         (no replay), a fresh tracker each (pipeline::run_track), {} start; seeds: {};\n"
+               "         steady_clock around the tracker's calls alone; median over the rounds;\n"
+               "         x efast: tracker ns/event over eFAST's in the same round (median)\n\n",
+               o.init, seeding);
+    flush_checked(out);
+
+    const std::uint64_t runs_per_input = static_cast<std::uint64_t>(o.repeat) * (1 + trackers.size());
+    Progress progress(!o.quiet && !o.no_progress, runs_per_input * o.inputs.size());
+    std::uint64_t passes_done = 0, events_done = 0;
+    const PassDone done = [&](std::uint64_t events) {
+        ++passes_done;
+        events_done += events;
+        progress.update(passes_done, events_done);
+    };
+    std::vector<TrackerRow> rows;
+    for (const std::string& input : o.inputs) {
+        LoadedEvents file = load_events(input, o.in, !o.quiet && !o.no_progress);
+        if (file.events.empty()) {
+            progress.finish();
+            fmt::print(stderr, "evcorner bench: {}: no events, skipped\n", input);
+            passes_done += runs_per_input;
+            continue;
+        }
+        for (TrackerRow& r : tracker_runs(input, file.events, file.size, runs, o, done)) {
+            if (!o.quiet) {
+                progress.finish();
+                fmt::print(stderr, "  {} {}: {:.1f} ns/event, {:.1f} ns/update\n", short_name(input), r.tracker,
+                           r.median_event, r.median_update);
+            }
+            rows.push_back(std::move(r));
+        }
+    }
+    progress.finish();
+    if (!o.quiet) fmt::print(stderr, "\n");
+    print_tracker_table(out, rows, !seed_detector.empty());
+    flush_checked(out);
+    if (!o.json.empty()) write_tracker_json(o.json, rows, cpu, o, seeding);
+}
+
 std::vector<std::string> split_list(const std::string& s) {
     std::vector<std::string> v;
     std::stringstream in(s);
@@ -547,6 +839,11 @@ void run_bench(const BenchOptions& o) {
             io::check_outputs_creatable({{"--json", o.json}});
         }
     }
+    if (!o.trackers.empty()) {
+        run_tracker_bench(o);
+        return;
+    }
+    if (!o.seeds.empty()) throw std::invalid_argument("--seeds: only with --tracker");
     // With the JSON on standard output, the human-readable report goes to standard error.
     std::FILE* const out = o.json == "-" ? stderr : stdout;
     const std::vector<std::string> detectors = parse_detector_list(o.detectors);  // unknown names fail now
@@ -664,12 +961,38 @@ void add_bench_command(CLI::App& app) {
         "Note: a short file replayed as identical copies is partly learned by the CPU's branch\n"
         "predictors, so its replayed figure is faster than a continuous stream of the same kind\n"
         "(docs/performance.md, \"What a replay measures\"; bench/bench_warmup.cpp measures the\n"
-        "cold start on a continuous recording instead).");
+        "cold start on a continuous recording instead).\n"
+        "With --tracker NAME the trackers are timed instead (seeded by --seeds FILE or -d DETECTOR):\n"
+        "ns per event, ns per in-range (event, track) update, live tracks, and the ratio to eFAST\n"
+        "detect's ns per event timed in the same rounds (docs/tracking.md, \"Speed\").");
     cmd->add_option("FILE", o->inputs, "Event files (any format evcorner reads)")->required();
-    cmd->add_option("-d,--detectors", o->detectors,
-                    "Comma-separated detectors to run, or all [default: all registered, each with its defaults "
-                    "unless the parameter options below are given]:" +
-                        detectors_help());
+    CLI::Option* detectors_opt =
+        cmd->add_option("-d,--detectors", o->detectors,
+                        "Comma-separated detectors to run, or all [default: all registered, each with its defaults "
+                        "unless the parameter options below are given]; with --tracker, the one detector whose "
+                        "corners seed the tracks (as evcorner track -d):" +
+                            detectors_help());
+    std::string trackers;
+    for (const TrackerEntry& t : tracker_registry()) trackers += fmt::format("\n  {:<24}{}", t.name, t.summary);
+    cmd->add_option("--tracker", o->trackers,
+                    "Time this tracker instead of the detectors (repeatable or comma-separated; all = every "
+                    "registered tracker), seeded by --seeds FILE or -d DETECTOR; each round runs eFAST detect and "
+                    "then every tracker once over each input as it is (no replay) through the tracking pipeline, "
+                    "and the report gives per tracker ns per event, ns per in-range (event, track) update and the "
+                    "ratio to eFAST's ns per event in the same round, medians over --repeat rounds. Not with "
+                    "--threads, --yardstick or --cpu-time; --min-events, --replay-gap and --no-latency do not "
+                    "apply:" +
+                        trackers)
+        ->delimiter(',')
+        ->allow_extra_args(false);
+    cmd->add_option("--seeds", o->seeds,
+                    "With --tracker: the seeds file, as evcorner track --seeds takes it (HASTE's 't,x,y,theta[,id]' "
+                    "tokens, or a track file's 'id t x y' rows: each id's first row seeds it)");
+    cmd->add_option("--init", o->init,
+                    "With --tracker: how a HASTE track's first window is filled, centered or uncentered (as "
+                    "evcorner track --init)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"centered", "uncentered"}));
     add_param_options(*cmd, o->detector_params);
     cmd->add_option("--repeat", o->repeat, "Timed passes per detector and input")
         ->capture_default_str()
@@ -714,8 +1037,13 @@ void add_bench_command(CLI::App& app) {
         "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt --min-events 1 --no-latency   # cold only (no replay)\n"
         "  evcorner bench ../shared/data/real/ecd-stppp/*/events.txt -d efast --yardstick --no-latency\n"
         "  evcorner bench recording.raw -d efast --repeat 9 --min-events 20000000 --json bench.json\n"
-        "  evcorner bench hd.raw -d efast --threads 1,2          # multi-core speed-up");
-    cmd->callback([o] { run_bench(*o); });
+        "  evcorner bench hd.raw -d efast --threads 1,2          # multi-core speed-up\n"
+        "  evcorner bench ev.npy --size 640x480 --tracker all --seeds gt.txt --init uncentered   # trackers\n"
+        "  evcorner bench events.txt --tracker haste-correlation-star -d arcstar --repeat 9");
+    cmd->callback([o, detectors_opt] {
+        o->detectors_given = detectors_opt->count() > 0;
+        run_bench(*o);
+    });
 }
 
 }  // namespace evcorner::cli
