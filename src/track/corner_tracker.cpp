@@ -162,7 +162,7 @@ private:
     void separate(std::uint32_t i, std::int64_t t) {
         const double sep2 = c_.stop.min_separation * c_.stop.min_separation;
         const int cx = static_cast<int>(tracks_[i].cell) % cols_, cy = static_cast<int>(tracks_[i].cell) / cols_;
-        const int reach = static_cast<int>(std::ceil(c_.stop.min_separation / cell_));
+        const int reach = static_cast<int>(std::min(std::ceil(c_.stop.min_separation / cell_), double(std::max(cols_, rows_))));
         near_.clear();
         for (int gy = std::max(cy - reach, 0); gy <= std::min(cy + reach, rows_ - 1); ++gy)
             for (int gx = std::max(cx - reach, 0); gx <= std::min(cx + reach, cols_ - 1); ++gx)
