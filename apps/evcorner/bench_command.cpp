@@ -68,6 +68,7 @@
 #include "eval_common.hpp"
 #include "evcorner/registry.hpp"
 #include "evcorner/detector.hpp"
+#include "evcorner/io/memory_reader.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
 #include "evcorner/pipeline/track.hpp"
@@ -416,58 +417,6 @@ Row bench_parallel(const std::string& input, const std::string& name, int thread
 
 // ----------------------------------------------------------------- trackers
 
-/// A loaded input handed to the tracking pipeline (pipeline::run_track) as a file reader
-/// would hand it: batches of events, nothing skipped.
-class MemoryReader final : public io::EventReader {
-public:
-    MemoryReader(std::span<const Event> events, SensorSize sensor, const std::string& name)
-        : events_(events), sensor_(sensor), name_(name) {}
-    std::size_t read(std::span<Event> out) override {
-        const std::size_t n = std::min(out.size(), events_.size() - next_);
-        std::copy_n(events_.begin() + static_cast<std::ptrdiff_t>(next_), n, out.begin());
-        next_ += n;
-        return n;
-    }
-    [[nodiscard]] std::span<const io::SkipRun> skipped_in_batch() const noexcept override { return {}; }
-    [[nodiscard]] std::uint64_t skipped() const noexcept override { return 0; }
-    [[nodiscard]] std::optional<SensorSize> sensor() const noexcept override { return sensor_; }
-    [[nodiscard]] std::string_view format() const noexcept override { return "memory"; }
-    [[nodiscard]] const std::string& name() const noexcept override { return name_; }
-    [[nodiscard]] std::uint64_t bytes_consumed() const noexcept override { return next_ * sizeof(Event); }
-    [[nodiscard]] std::optional<std::uint64_t> bytes_total() const noexcept override {
-        return events_.size() * sizeof(Event);
-    }
-
-private:
-    std::span<const Event> events_;
-    std::size_t next_ = 0;
-    SensorSize sensor_;
-    std::string name_;
-};
-
-/// --tracker's names, "all" expanded to every registered tracker, each once, in order;
-/// throws std::invalid_argument for an unknown one (naming the trackers there are).
-std::vector<std::string> parse_tracker_list(const std::vector<std::string>& names) {
-    std::vector<std::string> out;
-    auto add = [&](std::string_view n) {
-        if (std::find(out.begin(), out.end(), n) == out.end()) out.emplace_back(n);
-    };
-    for (const std::string& n : names) {
-        if (n == "all") {
-            for (const TrackerEntry& t : tracker_registry()) add(t.name);
-            continue;
-        }
-        try {
-            (void)tracker_entry(n);
-        } catch (const std::invalid_argument& e) {
-            throw std::invalid_argument(std::string("--tracker: ") + e.what());
-        }
-        add(n);
-    }
-    if (out.empty()) throw std::invalid_argument("--tracker: no tracker named");
-    return out;
-}
-
 /// What `evcorner track` would run for `tracker` with these seeds (--seeds), or seeded from
 /// the corners of -d's one detector with that command's front-end stopping rules.
 pipeline::TrackOptions track_options(const BenchOptions& o, const std::string& tracker,
@@ -517,7 +466,7 @@ std::vector<TrackerRow> tracker_runs(const std::string& input, const std::vector
             efast);
         done(file.size());
         for (std::size_t i = 0; i < runs.size(); ++i) {
-            MemoryReader reader(file, sensor, input);
+            io::MemoryReader reader(file, sensor, input);
             const pipeline::TrackSummary t = pipeline::run_track(reader, runs[i], discard, sensor);
             TrackerRow& row = rows[i];
             row.events = t.events;
@@ -745,7 +694,12 @@ void write_tracker_json(const std::string& path, const std::vector<TrackerRow>& 
 /// evcorner bench --tracker: the trackers instead of the detectors, each beside eFAST detect.
 void run_tracker_bench(const BenchOptions& o) {
     std::FILE* const out = o.json == "-" ? stderr : stdout;
-    const std::vector<std::string> trackers = parse_tracker_list(o.trackers);
+    std::vector<std::string> trackers;
+    try {
+        trackers = tracker_list(o.trackers);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(std::string("--tracker: ") + e.what());
+    }
     if (o.threads != "1") throw std::invalid_argument("--threads: trackers run on one thread; drop --threads with --tracker");
     if (o.yardstick) throw std::invalid_argument("--yardstick: not with --tracker (the tracker rows have eFAST's ratio)");
     if (o.cpu_time)

@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "commands.hpp"
@@ -42,8 +43,10 @@
 #include "evcorner/io/open.hpp"
 #include "evcorner/io/output_file.hpp"
 #include "evcorner/io/output_paths.hpp"
+#include "evcorner/pipeline/track_eval.hpp"
 #include "evcorner/render/figures.hpp"
 #include "evcorner/render/frame.hpp"
+#include "evcorner/track/tracker.hpp"
 #include "progress.hpp"
 
 namespace evcorner::cli {
@@ -77,6 +80,10 @@ struct EvalOptions {
     bool nms = false, compare_nms = false;
     NmsParams nms_params;
     std::string nms_rule = "window";
+    // Trackers against GT tracks (pipeline/track_eval.hpp).
+    bool tracks = false;
+    std::string trackers = "all";
+    std::string tracks_golden;
 };
 
 // One evaluated kind: a detector, with or without NMS after it ("NAME+nms").
@@ -172,6 +179,15 @@ std::string file_stem_of(const fs::path& file) {
     return stem.string();
 }
 
+// The GT tracks beside an event file: NAME.gt-tracks.txt for NAME.events.EXT (simulate
+// --suite) or NAME.EXT; empty when there is none.
+fs::path gt_tracks_beside(const fs::path& events) {
+    std::string base = file_stem_of(events);
+    if (base.size() > 7 && base.ends_with(".events")) base.resize(base.size() - 7);
+    const fs::path t = events.parent_path() / (base + ".gt-tracks.txt");
+    return fs::is_regular_file(t) && t != events ? t : fs::path();
+}
+
 // Makes every name unique. Inputs of one name that are different files take, all alike,
 // the fewest of these that tells them apart: level 0 the name; for a file named after its
 // stem, level 1 its file name with the extension; then one parent folder more per level.
@@ -260,11 +276,14 @@ std::vector<Sequence> find_sequences(const std::vector<std::string>& inputs) {
             seqs.push_back({name, name, p, {}, {}});
         }
     }
-    // A simulated scene's events take the scene's name and its truth.
+    // A simulated scene's events take the scene's name and its truth (or its GT tracks' name).
     for (Sequence& q : seqs) {
         q.truth = truth_beside(q.file);
-        if (q.truth.empty()) continue;
-        q.name = q.base = q.truth.filename().string().substr(0, q.truth.filename().string().size() - 10);
+        if (!q.truth.empty()) {
+            q.name = q.base = q.truth.filename().string().substr(0, q.truth.filename().string().size() - 10);
+        } else if (const fs::path gt = gt_tracks_beside(q.file); !gt.empty()) {
+            q.name = q.base = gt.filename().string().substr(0, gt.filename().string().size() - 14);
+        }
     }
     make_names_unique(seqs);
     // Figure stems: the name's folders joined by '_'; one that meets another name's gets a number.
@@ -672,6 +691,161 @@ std::vector<eval::TruthMatchResult> match_against_truth(const fs::path& truth, c
     return out;
 }
 
+// ---- Tracking against GT tracks (--tracks; pipeline/track_eval.hpp) ----
+
+// One output of the authors' HASTE app in a --tracks-golden folder: <tracker>.<init>.txt.gz.
+struct GoldenRun {
+    std::string tracker;  ///< our name of it (haste_correlation_star -> haste-correlation-star)
+    std::string init;     ///< centered, uncentered
+    fs::path file;
+};
+
+std::vector<GoldenRun> golden_runs(const fs::path& dir) {
+    std::vector<GoldenRun> runs;
+    for (const auto& d : fs::directory_iterator(dir)) {
+        std::string name = d.path().filename().string();
+        if (!d.is_regular_file()) continue;
+        for (const char* ext : {".txt.gz", ".txt.zst", ".txt"})
+            if (name.ends_with(ext)) {
+                name.resize(name.size() - std::string_view(ext).size());
+                const auto dot = name.rfind('.');
+                if (dot == std::string::npos) break;
+                std::string tracker = name.substr(0, dot);
+                std::replace(tracker.begin(), tracker.end(), '_', '-');
+                const std::string init = name.substr(dot + 1);
+                if (init == "centered" || init == "uncentered") runs.push_back({tracker, init, d.path()});
+                break;
+            }
+    }
+    std::sort(runs.begin(), runs.end(), [](const GoldenRun& a, const GoldenRun& b) {
+        return std::tie(a.tracker, a.init) < std::tie(b.tracker, b.init);
+    });
+    return runs;
+}
+
+
+std::string fixed(double v, int digits) { return std::isfinite(v) ? fmt::format("{:.{}f}", v, digits) : "-"; }
+
+std::string tracking_table_text(const std::vector<pipeline::TrackEvalRow>& rows, bool markdown) {
+    std::string s;
+    if (markdown) {
+        s += "| sequence | tracker | seeding | FA | EFA | FA@5 | TE@5 px | FA async | tracks counted | unmatched | "
+             "predicted | GT tracks | ns/update |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        for (const auto& r : rows)
+            s += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {:.3f} | {} | {} | {} | {} | {} |\n",
+                             r.sequence, r.tracker, r.seeding, r.fa, r.efa, r.fa_5, r.te_5, r.fa_async,
+                             r.counted_tracks, r.unmatched_tracks, r.predicted_tracks, r.gt_tracks,
+                             fixed(r.ns_per_update, 0));
+        return s;
+    }
+    std::size_t ws = 8, wt = 7, wd = 7;
+    for (const auto& r : rows) {
+        ws = std::max(ws, r.sequence.size());
+        wt = std::max(wt, r.tracker.size());
+        wd = std::max(wd, r.seeding.size());
+    }
+    s += fmt::format("{:<{}}  {:<{}}  {:<{}}  {:>6} {:>6} {:>6} {:>7} {:>8} {:>7} {:>9} {:>10}\n", "sequence", ws,
+                     "tracker", wt, "seeding", wd, "FA", "EFA", "FA@5", "TE@5 px", "FA async", "counted", "unmatched",
+                     "ns/update");
+    for (const auto& r : rows)
+        s += fmt::format("{:<{}}  {:<{}}  {:<{}}  {:>6.3f} {:>6.3f} {:>6.3f} {:>7.2f} {:>8.3f} {:>7} {:>9} {:>10}\n",
+                         r.sequence, ws, r.tracker, wt, r.seeding, wd, r.fa, r.efa, r.fa_5, r.te_5, r.fa_async,
+                         r.counted_tracks, r.unmatched_tracks, fixed(r.ns_per_update, 0));
+    return s;
+}
+
+// Per tracker and seeding, the mean over the sequences (the benchmark's tables end so).
+std::string tracking_mean_text(const std::vector<pipeline::TrackEvalRow>& rows, bool markdown) {
+    std::vector<std::pair<std::string, std::string>> order;
+    std::map<std::pair<std::string, std::string>, std::vector<const pipeline::TrackEvalRow*>> by;
+    for (const auto& r : rows) {
+        const auto key = std::make_pair(r.tracker, r.seeding);
+        if (!by.count(key)) order.push_back(key);
+        by[key].push_back(&r);
+    }
+    std::size_t wt = 7, wd = 7;
+    for (const auto& [t, d] : order) {
+        wt = std::max(wt, t.size());
+        wd = std::max(wd, d.size());
+    }
+    std::string s = markdown ? "| tracker | seeding | sequences | FA | EFA | FA@5 | TE@5 px | FA async |\n"
+                               "|---|---|---:|---:|---:|---:|---:|---:|\n"
+                             : fmt::format("{:<{}}  {:<{}}  {:>4} {:>6} {:>6} {:>6} {:>7} {:>8}\n", "tracker", wt,
+                                           "seeding", wd, "seqs", "FA", "EFA", "FA@5", "TE@5 px", "FA async");
+    for (const auto& key : order) {
+        const auto& v = by[key];
+        double fa = 0, efa = 0, fa5 = 0, te5 = 0, fas = 0;
+        for (const auto* r : v) {
+            fa += r->fa;
+            efa += r->efa;
+            fa5 += r->fa_5;
+            te5 += r->te_5;
+            fas += r->fa_async;
+        }
+        const double n = static_cast<double>(v.size());
+        s += markdown ? fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {:.3f} |\n", key.first,
+                                    key.second, v.size(), fa / n, efa / n, fa5 / n, te5 / n, fas / n)
+                      : fmt::format("{:<{}}  {:<{}}  {:>4} {:>6.3f} {:>6.3f} {:>6.3f} {:>7.2f} {:>8.3f}\n", key.first,
+                                    wt, key.second, wd, v.size(), fa / n, efa / n, fa5 / n, te5 / n, fas / n);
+    }
+    return s;
+}
+
+nlohmann::json tracking_row_json(const pipeline::TrackEvalRow& r, bool authors) {
+    static constexpr const char* kinds[] = {"gt", "detector", "seeds"};
+    return {{"sequence", r.sequence},
+            {"tracker", r.tracker},
+            {"seeding", r.seeding},
+            {"seeding_kind", kinds[static_cast<int>(r.kind)]},
+            {"source", authors ? "the authors' HASTE app" : "evcorner"},
+            {"fa", r.fa},
+            {"efa", r.efa},
+            {"fa_5", r.fa_5},
+            {"te_5", r.te_5},
+            {"fa_async", r.fa_async},
+            {"predicted_tracks", r.predicted_tracks},
+            {"gt_tracks", r.gt_tracks},
+            {"counted_tracks", r.counted_tracks},
+            {"skipped_tracks", r.skipped_tracks},
+            {"unmatched_tracks", r.unmatched_tracks},
+            {"unseeded_tracks", r.unseeded_tracks},
+            {"states", r.states},
+            {"updates", r.updates},
+            {"ns_per_update", std::isfinite(r.ns_per_update) ? nlohmann::json(r.ns_per_update) : nlohmann::json(nullptr)},
+            {"track_s", r.track_s},
+            {"gt_rate_hz", r.gt_rate_hz}};
+}
+
+// What the tracking table is: the protocol, one item a line, for the report and the standard output.
+std::vector<std::string> tracking_protocol(const std::vector<std::string>& detectors, const std::string& gt_rate,
+                                           bool golden, const std::string& unseeded) {
+    std::string dets;
+    for (const auto& d : detectors) dets += (dets.empty() ? "" : ", ") + d;
+    std::vector<std::string> lines{
+        "Metric: the feature-track benchmark's (Messikommer et al., CVPR 2023; docs/tracking-metrics.md), "
+        "synchronous mode (the GT cut to each track's span); thresholds 1..31 px; FA async: the asynchronous "
+        "variant (a track holds its last position to the GT's end).",
+        "GT: NAME.gt-tracks.txt beside the events (every visible truth corner as a track, a new id per visible "
+        "stretch), sampled at " + gt_rate + " Hz, pixel-index convention (pixel u spans u-0.5..u+0.5, as the "
+        "trackers report).",
+        "Seeding GT t0: each GT track's first sample seeds the tracker under its id (uncentered start, no "
+        "stopping rule beyond the tracker's); scored by id, without the start shift. A GT track starting within "
+        "half a pixel of the border (off [0, W) x [0, H), where the trackers refuse a seed) is not seeded and, "
+        "having no prediction, counts nowhere, as in the benchmark" + unseeded + ".",
+        "Seeding " + (dets.empty() ? std::string("DETECTOR") : dets) +
+            ": the detector's corner events seed the tracks (the front end of evcorner track -d: seed radius "
+            "10 px, at most 200 tracks, centered start, max idle 200 ms, min separation 3 px); scored by "
+            "association: in order of their first time, each track takes the nearest GT track not yet taken "
+            "within 3 px of its first position at its first time and is measured against it from then on; a "
+            "track with none in reach is unmatched and counted nowhere."};
+    if (golden)
+        lines.push_back("Seedings golden seeds (uncentered, centered): the seeds.txt of --tracks-golden, HASTE's start "
+                        "either way, for our trackers and the authors' HASTE app alike; each track is scored against "
+                        "the GT track nearest its seed (within 1 px) from the seed's time on.");
+    lines.push_back("ns/update: tracking time per (event, track) pair processed, one thread.");
+    return lines;
+}
+
 void run_eval(EvalOptions& o) {
     finish_feature_track_params(o.params, o.overlap);
     const std::vector<std::string> detectors = parse_detector_list(o.detectors);
@@ -691,6 +865,16 @@ void run_eval(EvalOptions& o) {
             throw std::invalid_argument("--nms: detector '" + d + "' has no score to suppress by");
         if (!o.nms) configs.push_back({c, std::nullopt, d});
         if (nms) configs.push_back({c, nms, d + "+nms"});
+    }
+    std::vector<std::string> trackers;
+    if (o.tracks) {
+        try {
+            trackers = tracker_list(std::span(&o.trackers, 1));
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(std::string("--trackers: ") + e.what());
+        }
+        if (!o.tracks_golden.empty() && !fs::is_regular_file(fs::path(o.tracks_golden) / "seeds.txt"))
+            throw std::invalid_argument("--tracks-golden: " + o.tracks_golden + " holds no seeds.txt");
     }
     std::vector<Sequence> seqs = find_sequences(o.inputs);
     o.match.credit = eval::parse_credit(o.credit);
@@ -1003,6 +1187,74 @@ void run_eval(EvalOptions& o) {
                                            {render::kOffBright, "OFF corner event"}}));
         }
     }
+    // Trackers against the GT tracks beside the sequences (--tracks): the library runs them.
+    std::vector<pipeline::TrackEvalRow> track_rows, golden_rows;
+    std::vector<std::string> without_gt_tracks;
+    std::string golden_note, gt_rate;
+    if (o.tracks) {
+        std::vector<pipeline::TrackSeeding> seedings{pipeline::gt_seeding()};
+        for (const auto& d : detectors) seedings.push_back(pipeline::detector_seeding(config_for(d, o.detector_params)));
+        std::set<double> rates;
+        std::string shapes_name;
+        fs::path shapes_gt;
+        for (const Sequence& seq : seqs) {
+            const fs::path gt = gt_tracks_beside(seq.file);
+            if (gt.empty()) {
+                without_gt_tracks.push_back(seq.name);
+                continue;
+            }
+            pipeline::TrackEvalFiles f;
+            f.sequence = seq.name;
+            f.events = seq.file.string();
+            f.format = o.in.format;
+            f.reader = o.in.reader;
+            const std::string size = o.in.size.empty() ? scene_sensor_beside(seq) : o.in.size;
+            if (!size.empty()) f.reader.sensor = parse_sensor_size(size);
+            f.gt = gt.string();
+            std::vector<pipeline::TrackSeeding> these = seedings;
+            const bool golden = !o.tracks_golden.empty() && seq.base == "shapes" && shapes_name.empty();
+            if (golden) {
+                // Our trackers from the authors' seeds, both starts: each authors' row has its twin.
+                const std::string seeds = (fs::path(o.tracks_golden) / "seeds.txt").string();
+                these.push_back(pipeline::seeds_seeding(seeds, "golden seeds (uncentered)", HasteInit::uncentered));
+                these.push_back(pipeline::seeds_seeding(seeds, "golden seeds (centered)", HasteInit::centered));
+                shapes_name = seq.name;
+                shapes_gt = gt;
+            }
+            if (!o.quiet)
+                fmt::print(stderr, "eval: {}: tracking against {} ({} trackers x {} seedings)\n", seq.name, gt.string(),
+                           trackers.size(), these.size());
+            const auto rows = pipeline::evaluate_trackers(f, trackers, these, {}, [&](const pipeline::TrackEvalRow& r) {
+                if (!o.quiet)
+                    fmt::print(stderr, "eval: {}: {} / {}: FA {:.3f}, {} tracks counted ({:.1f} s)\n", r.sequence,
+                               r.tracker, r.seeding, r.fa, r.counted_tracks, r.track_s);
+            });
+            for (const auto& r : rows) {
+                if (r.gt_rate_hz > 0) rates.insert(std::round(r.gt_rate_hz * 1000) / 1000);
+                track_rows.push_back(r);
+            }
+        }
+        if (!o.tracks_golden.empty()) {
+            if (shapes_name.empty()) {
+                golden_note = "--tracks-golden " + o.tracks_golden +
+                              ": no `shapes` scene with GT tracks among the inputs, so the authors' outputs are not scored";
+                fmt::print(stderr, "eval: {}\n", golden_note);
+            } else {
+                const std::string seeds = (fs::path(o.tracks_golden) / "seeds.txt").string();
+                for (const GoldenRun& g : golden_runs(o.tracks_golden)) {
+                    pipeline::TrackEvalRow r = pipeline::evaluate_track_file(g.file.string(), shapes_gt.string(), seeds);
+                    r.sequence = shapes_name;
+                    r.tracker = "authors' " + g.tracker;
+                    r.seeding = "golden seeds (" + g.init + ")";
+                    golden_rows.push_back(std::move(r));
+                }
+                if (golden_rows.empty())
+                    golden_note = "--tracks-golden " + o.tracks_golden + ": no <tracker>.<init>.txt.gz output inside";
+            }
+        }
+        for (const double r : rates) gt_rate += (gt_rate.empty() ? "" : ", ") + fmt::format("{:g}", r);
+        if (gt_rate.empty()) gt_rate = "?";
+    }
     const eval::Table1 t1 = eval::make_table1(runs);
     const eval::Table2 t2 = eval::make_table2(runs);
     fmt::print("Table 1: reduction rate (Red.) and corners on feature tracks (FT), %\n{}\n", table1_text(t1, false, ft_notes));
@@ -1019,6 +1271,28 @@ void run_eval(EvalOptions& o) {
         fmt::print("\nMean over the sequences (AP: average precision of the score's PR curve, docs/evaluation.md; "
                    "smear: true corner events per visible truth corner per ms)\n{}",
                    truth_summary_text(truth_rows, false));
+    }
+    std::map<std::string, std::size_t> unseeded_by_sequence;  // the GT t0 rows of a sequence all say the same
+    for (const auto& r : track_rows)
+        if (r.kind == pipeline::SeedingKind::gt && r.unseeded_tracks > 0) unseeded_by_sequence[r.sequence] = r.unseeded_tracks;
+    std::string unseeded_text;
+    for (const auto& [name, n] : unseeded_by_sequence)
+        unseeded_text += fmt::format("{}{} {}", unseeded_text.empty() ? "" : ", ", name, n);
+    unseeded_text = unseeded_text.empty() ? " (none here)" : " (not seeded: " + unseeded_text + ")";
+    std::vector<pipeline::TrackEvalRow> all_track_rows = track_rows;
+    all_track_rows.insert(all_track_rows.end(), golden_rows.begin(), golden_rows.end());
+    std::string no_gt_text;
+    for (const auto& n : without_gt_tracks) no_gt_text += (no_gt_text.empty() ? "" : ", ") + n;
+    const std::vector<std::string> protocol =
+        o.tracks ? tracking_protocol(detectors, gt_rate, !golden_rows.empty(), unseeded_text) : std::vector<std::string>();
+    if (o.tracks) {
+        fmt::print("\nTracking against GT tracks\n");
+        for (const auto& line : protocol) fmt::print("  {}\n", line);
+        if (!all_track_rows.empty())
+            fmt::print("{}\nMean over the sequences\n{}", tracking_table_text(all_track_rows, false),
+                       tracking_mean_text(all_track_rows, false));
+        if (!without_gt_tracks.empty()) fmt::print("Without GT tracks (not tracked): {}\n", no_gt_text);
+        if (!golden_note.empty()) fmt::print("{}\n", golden_note);
     }
     if (o.report.empty()) return;
     const fs::path dir(o.report);
@@ -1059,6 +1333,21 @@ void run_eval(EvalOptions& o) {
                     {"radius", nms->radius},
                     {"time_us", nms->time_us},
                     {"compare", o.compare_nms}};
+    }
+    if (o.tracks) {
+        nlohmann::json rows = nlohmann::json::array();
+        for (const auto& r : track_rows) rows.push_back(tracking_row_json(r, false));
+        for (const auto& r : golden_rows) rows.push_back(tracking_row_json(r, true));
+        j["tracking"] = {{"mode", "synchronous"},
+                         {"thresholds_px", 31},
+                         {"association_radius_px", 3},
+                         {"seeds_radius_px", 1},
+                         {"protocol", protocol},
+                         {"trackers", trackers},
+                         {"golden", o.tracks_golden.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.tracks_golden)},
+                         {"rows", rows},
+                         {"without_gt_tracks", without_gt_tracks}};
+        if (!golden_note.empty()) j["tracking"]["golden_note"] = golden_note;
     }
     write_file(dir / "results.json", j.dump(2) + "\n");
     std::string md = "# evcorner evaluation\n\n";
@@ -1110,6 +1399,22 @@ void run_eval(EvalOptions& o) {
                   "space-time |\n|---|---|---|---|\n" + truth_figures_md + "\n";
     }
     md += "Paper (one core of an i7-3720QM, 2.6 GHz): Harris 11.6 us / 86,230 e/s; eFAST 0.78 us / 1,275,000 e/s.\n\n";
+    if (o.tracks) {
+        md += "## Tracking\n\nFeature trackers against ground-truth (GT) tracks, every tracker under every seeding "
+              "on every sequence with GT tracks (docs/tracking.md).\n\n";
+        for (const auto& line : protocol) md += "- " + line + "\n";
+        md += "\n";
+        if (!golden_rows.empty())
+            md += "Authors' HASTE rows: the outputs of the authors' app (" + o.tracks_golden +
+                  ", run on the golden input of the shapes scene from its seeds.txt) scored against this run's `" +
+                  golden_rows.front().sequence + "` GT by the same metric, through those seeds.\n\n";
+        if (!all_track_rows.empty())
+            md += tracking_table_text(all_track_rows, true) + "\n### Mean over the sequences\n\n" +
+                  tracking_mean_text(all_track_rows, true) + "\n";
+        if (!without_gt_tracks.empty())
+            md += "Without GT tracks (no NAME.gt-tracks.txt beside the events; not tracked): " + no_gt_text + ".\n\n";
+        if (!golden_note.empty()) md += golden_note + ".\n\n";
+    }
     if (!figures_md.empty()) {
         md += "## Figures\n\nCorners of the last 33 ms (bright) and 100 ms (dark), green ON, red OFF (Fig. 6); "
               "corner events in space-time over the whole sequence, green on a feature track, red off it "
@@ -1140,9 +1445,11 @@ void add_eval_command(CLI::App& app) {
                     "its event files (" + event_extensions_text() + "), other files skipped with a note")
         ->required();
     cmd->add_option("-d,--detectors", o->detectors,
-                    "Comma-separated detectors, or all [default: all, each with its defaults (the paper's for "
-                    "efast, harris and harris-global)]:" +
+                    "Comma-separated detectors, or all; repeatable (-d efast -d arcstar) [default: all, each with its "
+                    "defaults (the paper's for efast, harris and harris-global)]:" +
                         detectors_help())
+        ->delimiter(',')
+        ->multi_option_policy(CLI::MultiOptionPolicy::Join)
         ->check([](const std::string& list) {
             try {
                 (void)parse_detector_list(list);
@@ -1200,6 +1507,30 @@ void add_eval_command(CLI::App& app) {
                     "Image-speed bin edges, px/s, from 0, increasing [default: 0,50,100,200,400,700]")
         ->delimiter(',')
         ->group(tg);
+    const auto trg = "Tracking against GT tracks (docs/tracking.md)";
+    CLI::Option* tracks =
+        cmd->add_flag("--tracks", o->tracks,
+                      "Also evaluate the trackers on every sequence with GT tracks beside it (NAME.gt-tracks.txt "
+                      "for NAME.events.EXT or NAME.EXT, as simulate --suite writes them): each tracker seeded at "
+                      "the GT's first samples (GT t0, scored by id) and by each -d detector as a front end (scored "
+                      "by association within 3 px), by the feature-track benchmark's FA, EFA, FA@5, TE@5 "
+                      "(synchronous) and the asynchronous FA; sequences without GT tracks are listed as such")
+            ->group(trg);
+    cmd->add_option("--trackers", o->trackers, "With --tracks: comma-separated trackers, or all:" + [] {
+        std::string h;
+        for (const TrackerEntry& t : tracker_registry()) h += fmt::format("\n  {:<24}{}", t.name, t.summary);
+        return h;
+    }())
+        ->capture_default_str()
+        ->needs(tracks)
+        ->group(trg);
+    cmd->add_option("--tracks-golden", o->tracks_golden,
+                    "With --tracks: a folder of the authors' HASTE app outputs on the shapes scene (seeds.txt and "
+                    "<tracker>.<init>.txt.gz, e.g. ../shared/data/golden/haste/sim-shapes): each is scored against "
+                    "the `shapes` scene's GT through those seeds, beside our trackers run from the same seeds")
+        ->check(CLI::ExistingDirectory)
+        ->needs(tracks)
+        ->group(trg);
     cmd->footer(
         "Examples:\n"
         "  evcorner eval ../shared/data/real/ecd-stppp --report eval-report\n"
@@ -1207,7 +1538,8 @@ void add_eval_command(CLI::App& app) {
         "  evcorner eval ../shared/data/real/ecd-stppp -d all --harris-window 7 --no-figures\n"
         "  evcorner eval scene.npy --truth scene.truth.csv --report r     (simulate -o scene.npy --truth ...)\n"
         "  evcorner eval suite/ --report r                                (simulate --suite suite/)\n"
-        "  evcorner eval suite/ --compare-nms --nms-rule window --report r (each detector with and without NMS)");
+        "  evcorner eval suite/ --compare-nms --nms-rule window --report r (each detector with and without NMS)\n"
+        "  evcorner eval suite/ -d efast,arcstar --tracks --report r      (and the trackers against GT tracks)");
     cmd->callback([o] { run_eval(*o); });
 }
 

@@ -96,4 +96,27 @@ const TrackerEntry& tracker_entry(std::string_view name) {
     throw std::invalid_argument("unknown tracker '" + std::string(name) + "' (trackers: " + tracker_names() + ")");
 }
 
+std::vector<std::string> tracker_list(std::span<const std::string> names) {
+    std::vector<std::string> out;
+    const auto add = [&](std::string_view n) {
+        if (std::find(out.begin(), out.end(), n) == out.end()) out.emplace_back(n);
+    };
+    for (const std::string& item : names) {
+        std::size_t at = 0;
+        while (at <= item.size()) {
+            const std::size_t comma = std::min(item.find(',', at), item.size());
+            const std::string_view name = std::string_view(item).substr(at, comma - at);
+            at = comma + 1;
+            if (name.empty()) continue;
+            if (name == "all") {
+                for (const TrackerEntry& t : kTrackers) add(t.name);
+            } else {
+                add(tracker_entry(name).name);
+            }
+        }
+    }
+    if (out.empty()) throw std::invalid_argument("no tracker named (trackers: " + tracker_names() + ")");
+    return out;
+}
+
 }  // namespace evcorner

@@ -68,5 +68,9 @@ std::span<const TrackerEntry> tracker_registry();
 const TrackerEntry& tracker_entry(std::string_view name);
 /// "correlation, haste-correlation, ...".
 std::string tracker_names();
+/// Names as a command line gives them: each item one name, a comma-separated list of them,
+/// or "all" (every tracker, in the registry's order); each tracker once, in the order first
+/// named. Throws std::invalid_argument for an unknown name or when none is named.
+std::vector<std::string> tracker_list(std::span<const std::string> names);
 
 }  // namespace evcorner
