@@ -6,7 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "evcorner/error.hpp"
@@ -273,6 +279,57 @@ TEST(TrackFile, EveryLayoutTheWriterWritesReadsBack) {
             EXPECT_DOUBLE_EQ(back[i].t, static_cast<double>(states[i].t) / 1e6) << f;
             EXPECT_DOUBLE_EQ(back[i].x, states[i].x) << f;
             EXPECT_DOUBLE_EQ(back[i].y, states[i].y) << f;
+        }
+    }
+}
+
+TEST(TrackFile, TextLayoutsPrintWhatPrintfPrints) {
+    // Six decimals as printf's "%.6f" rounds them (ties to even, as glibc does), ids and
+    // times in full: random values, exact ties (odd multiples of 1/128), signs, zero, extremes.
+    std::vector<TrackState> states;
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<float> pos(-50.0f, 1300.0f);
+    std::uniform_int_distribution<std::int64_t> t(-5000000, 4000000000000);
+    for (int i = 0; i < 2000; ++i)
+        states.push_back({t(rng), pos(rng), static_cast<float>(2 * i + 1) / 128.0f, pos(rng) * 1e-3f, rng(), TrackChange::moved});
+    for (const float v : {0.0f, -0.0f, -0.0000004f, 0.0000005f, 1e-7f, -3.0078125f, 3.4e38f, -1e30f})
+        states.push_back({0, v, -v, v, std::uint64_t(-1), TrackChange::stopped});
+    TempDir dir;
+    const auto lines_of = [](const std::string& text) {
+        std::vector<std::string> v;
+        std::istringstream in(text);
+        for (std::string l; std::getline(in, l);) v.push_back(l);
+        return v;
+    };
+    const auto seconds = [](std::int64_t us) {
+        const std::uint64_t a = us < 0 ? 0 - static_cast<std::uint64_t>(us) : static_cast<std::uint64_t>(us);
+        char b[64];
+        std::snprintf(b, sizeof b, "%s%llu.%06llu", us < 0 ? "-" : "", static_cast<unsigned long long>(a / 1000000),
+                      static_cast<unsigned long long>(a % 1000000));
+        return std::string(b);
+    };
+    for (const char* f : {"ddft", "haste", "csv"}) {
+        const std::string path = dir.path(std::string("printf-") + f + ".txt");
+        TrackWriter w(path, *parse_track_format(f));
+        w.write(states);
+        w.close();
+        std::ifstream in(path, std::ios::binary);
+        std::vector<std::string> lines = lines_of(std::string(std::istreambuf_iterator<char>(in), {}));
+        if (std::string(f) == "csv") lines.erase(lines.begin());  // the header
+        ASSERT_EQ(lines.size(), states.size()) << f;
+        for (std::size_t i = 0; i < states.size(); ++i) {
+            const TrackState& s = states[i];
+            char b[512];
+            const auto id = static_cast<unsigned long long>(s.id);
+            const std::string ts = seconds(s.t);
+            if (std::string(f) == "ddft")
+                std::snprintf(b, sizeof b, "%llu %s %.6f %.6f", id, ts.c_str(), double(s.x), double(s.y));
+            else if (std::string(f) == "haste")
+                std::snprintf(b, sizeof b, "%s,%.6f,%.6f,%.6f,%llu", ts.c_str(), double(s.x), double(s.y), double(s.theta), id);
+            else
+                std::snprintf(b, sizeof b, "%llu,%s,%.6f,%.6f,%.6f,%s", id, ts.c_str(), double(s.x), double(s.y),
+                              double(s.theta), change_name(s.why));
+            ASSERT_EQ(lines[i], b) << f << " row " << i;
         }
     }
 }

@@ -1,7 +1,8 @@
 #include "evcorner/track/track_writer.hpp"
 
+#include <charconv>
+#include <cmath>
 #include <cstring>
-#include <fmt/format.h>
 
 #include "evcorner/error.hpp"
 #include "evcorner/io/npy.hpp"
@@ -15,11 +16,45 @@ constexpr std::string_view kNpyDescr =
     "[('id', '<u8'), ('t', '<i8'), ('x', '<f4'), ('y', '<f4'), ('theta', '<f4'), ('change', '|u1')]";
 constexpr std::size_t kNpyRecord = 29;
 
+/// Longest field: an id (20 digits), or a float in %.6f (39 integer digits, sign, point, 6).
+constexpr std::size_t kField = 48;
+
+template <class T>
+void append_int(std::string& s, T v) {
+    char b[kField];
+    s.append(b, std::to_chars(b, b + kField, v).ptr);
+}
+
+/// n / 1e6 with six decimals: "12.000345".
+void append_millionths(std::string& s, std::uint64_t n) {
+    append_int(s, n / 1000000);
+    char frac[7] = {'.', '0', '0', '0', '0', '0', '0'};
+    for (std::uint64_t f = n % 1000000, i = 6; f > 0; f /= 10, --i) frac[i] = static_cast<char>('0' + f % 10);
+    s.append(frac, 7);
+}
+
+/// As printf's "%.6f": the exact decimal value, rounded to 6 places, ties to even. A float
+/// times 1e6 is exact in a double (24 + 14 significant bits), so below 2^53 / 1e6 the rounded
+/// product is the answer; beyond, and for NaN and infinities, to_chars' fixed form (specified
+/// as printf's).
+void append_fixed6(std::string& s, float v) {
+    const double scaled = static_cast<double>(v) * 1e6;
+    if (!(std::fabs(scaled) < 0x1p53)) {
+        char b[kField];
+        s.append(b, std::to_chars(b, b + kField, v, std::chars_format::fixed, 6).ptr);
+        return;
+    }
+    const auto micro = static_cast<std::uint64_t>(std::nearbyint(std::fabs(scaled)));  // the default mode: ties to even
+    if (std::signbit(v)) s += '-';
+    append_millionths(s, micro);
+}
+
 /// Seconds from microseconds, exactly: "-0.000123", "12.345678".
 void append_seconds(std::string& s, std::int64_t us) {
     const bool neg = us < 0;
     const std::uint64_t a = neg ? 0 - static_cast<std::uint64_t>(us) : static_cast<std::uint64_t>(us);
-    fmt::format_to(std::back_inserter(s), "{}{}.{:06d}", neg ? "-" : "", a / 1000000, a % 1000000);
+    if (neg) s += '-';
+    append_millionths(s, a);
 }
 
 }  // namespace
@@ -63,19 +98,40 @@ void TrackWriter::write(std::span<const TrackState> states) {
     for (const TrackState& st : states) {
         switch (format_) {
             case TrackFormat::ddft:
-                fmt::format_to(std::back_inserter(s), "{} ", st.id);
+                append_int(s, st.id);
+                s += ' ';
                 append_seconds(s, st.t);
-                fmt::format_to(std::back_inserter(s), " {:.6f} {:.6f}\n", st.x, st.y);
+                s += ' ';
+                append_fixed6(s, st.x);
+                s += ' ';
+                append_fixed6(s, st.y);
+                s += '\n';
                 break;
             case TrackFormat::haste:
                 append_seconds(s, st.t);
-                fmt::format_to(std::back_inserter(s), ",{:.6f},{:.6f},{:.6f},{}\n", st.x, st.y, st.theta, st.id);
+                s += ',';
+                append_fixed6(s, st.x);
+                s += ',';
+                append_fixed6(s, st.y);
+                s += ',';
+                append_fixed6(s, st.theta);
+                s += ',';
+                append_int(s, st.id);
+                s += '\n';
                 break;
             case TrackFormat::csv:
-                fmt::format_to(std::back_inserter(s), "{},", st.id);
+                append_int(s, st.id);
+                s += ',';
                 append_seconds(s, st.t);
-                fmt::format_to(std::back_inserter(s), ",{:.6f},{:.6f},{:.6f},{}\n", st.x, st.y, st.theta,
-                               change_name(st.why));
+                s += ',';
+                append_fixed6(s, st.x);
+                s += ',';
+                append_fixed6(s, st.y);
+                s += ',';
+                append_fixed6(s, st.theta);
+                s += ',';
+                s += change_name(st.why);
+                s += '\n';
                 break;
             case TrackFormat::npy: {
                 char r[kNpyRecord];
