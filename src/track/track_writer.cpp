@@ -57,6 +57,24 @@ void append_seconds(std::string& s, std::int64_t us) {
     append_millionths(s, a);
 }
 
+/// A time in microseconds, written as seconds.
+struct Micros {
+    std::int64_t us;
+};
+
+void append_field(std::string& s, std::uint64_t v) { append_int(s, v); }
+void append_field(std::string& s, Micros t) { append_seconds(s, t.us); }
+void append_field(std::string& s, float v) { append_fixed6(s, v); }
+void append_field(std::string& s, const char* v) { s += v; }
+
+/// The fields joined by `sep`, then a newline.
+template <class First, class... Rest>
+void append_row(std::string& s, char sep, const First& first, const Rest&... rest) {
+    append_field(s, first);
+    ((s += sep, append_field(s, rest)), ...);
+    s += '\n';
+}
+
 }  // namespace
 
 struct TrackWriter::Out {
@@ -98,40 +116,13 @@ void TrackWriter::write(std::span<const TrackState> states) {
     for (const TrackState& st : states) {
         switch (format_) {
             case TrackFormat::ddft:
-                append_int(s, st.id);
-                s += ' ';
-                append_seconds(s, st.t);
-                s += ' ';
-                append_fixed6(s, st.x);
-                s += ' ';
-                append_fixed6(s, st.y);
-                s += '\n';
+                append_row(s, ' ', st.id, Micros{st.t}, st.x, st.y);
                 break;
             case TrackFormat::haste:
-                append_seconds(s, st.t);
-                s += ',';
-                append_fixed6(s, st.x);
-                s += ',';
-                append_fixed6(s, st.y);
-                s += ',';
-                append_fixed6(s, st.theta);
-                s += ',';
-                append_int(s, st.id);
-                s += '\n';
+                append_row(s, ',', Micros{st.t}, st.x, st.y, st.theta, st.id);
                 break;
             case TrackFormat::csv:
-                append_int(s, st.id);
-                s += ',';
-                append_seconds(s, st.t);
-                s += ',';
-                append_fixed6(s, st.x);
-                s += ',';
-                append_fixed6(s, st.y);
-                s += ',';
-                append_fixed6(s, st.theta);
-                s += ',';
-                s += change_name(st.why);
-                s += '\n';
+                append_row(s, ',', st.id, Micros{st.t}, st.x, st.y, st.theta, change_name(st.why));
                 break;
             case TrackFormat::npy: {
                 char r[kNpyRecord];
